@@ -1,0 +1,104 @@
+"""Input checks used at gmuk's public boundary (never in the integrator's hot path)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from gmuk.errors import NonFiniteError, NotOnGroupError, ShapeError
+
+FloatArray = NDArray[np.float64]
+
+#: Tolerance for RᵀR = I and for the homogeneous row of SE(3) elements.
+GROUP_TOL = 1e-9
+
+
+def as_array(x: Any, tail: tuple[int, ...], name: str, *, batch: bool = True) -> FloatArray:
+    """Return ``x`` as a finite float64 array whose trailing shape is ``tail``.
+
+    Parameters
+    ----------
+    x : array_like
+        The input.
+    tail : tuple of int
+        Required trailing shape, e.g. ``(6,)`` or ``(4, 4)``.
+    name : str
+        Name used in error messages.
+    batch : bool
+        Whether leading (batch) axes are allowed.
+
+    Raises
+    ------
+    ShapeError
+        If the trailing shape differs (or batch axes are present when not allowed).
+    NonFiniteError
+        If any entry is NaN or infinite.
+    """
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ShapeError(
+            f"{name} must be a numeric array of shape {_fmt(tail, batch)}; "
+            f"could not convert {type(x).__name__}: {exc}"
+        ) from None
+    k = len(tail)
+    if a.ndim < k or a.shape[a.ndim - k :] != tail or (not batch and a.ndim != k):
+        raise ShapeError(f"{name} must have shape {_fmt(tail, batch)}; got {a.shape}")
+    if not np.isfinite(a).all():
+        bad = int(np.size(a) - np.count_nonzero(np.isfinite(a)))
+        raise NonFiniteError(
+            f"{name} must be finite; got {bad} NaN/inf entr"
+            f"{'y' if bad == 1 else 'ies'} in an array of shape {a.shape}"
+        )
+    return a
+
+
+def _fmt(tail: tuple[int, ...], batch: bool) -> str:
+    inner = ", ".join(str(t) for t in tail)
+    return f"(..., {inner})" if batch else f"({inner}{',' if len(tail) == 1 else ''})"
+
+
+def check_rotation(R: Any, name: str = "R", tol: float = GROUP_TOL) -> FloatArray:
+    """Return ``R`` as an array of rotation matrices, or raise :class:`NotOnGroupError`.
+
+    A rotation matrix satisfies ``‖RᵀR − I‖_max ≤ tol`` and ``det R = +1`` (to ``tol``).
+    Leading batch axes are allowed; the message reports the worst element.
+    """
+    R = as_array(R, (3, 3), name)
+    err = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1))
+    det = np.linalg.det(R)
+    bad = (err > tol) | (np.abs(det - 1.0) > tol)
+    if np.any(bad):
+        i = (
+            np.unravel_index(
+                int(np.argmax(np.where(bad, err + np.abs(det - 1.0), -1.0))), bad.shape
+            )
+            if bad.ndim
+            else ()
+        )
+        where = f" at index {tuple(int(j) for j in i)}" if bad.ndim else ""
+        raise NotOnGroupError(
+            f"{name} must be a rotation matrix (RᵀR = I to {tol:g}, det +1){where}; "
+            f"got max|RᵀR − I| = {float(np.asarray(err)[i]):.3g}, "
+            f"det = {float(np.asarray(det)[i]):.6g}"
+        )
+    return R
+
+
+def check_se3(g: Any, name: str = "g", tol: float = GROUP_TOL) -> FloatArray:
+    """Return ``g`` as an array of 4×4 SE(3) matrices, or raise :class:`NotOnGroupError`.
+
+    The rotation block must pass :func:`check_rotation` and the last row must be
+    ``[0, 0, 0, 1]`` to ``tol``.
+    """
+    g = as_array(g, (4, 4), name)
+    row_err = np.abs(g[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max()
+    if row_err > tol:
+        raise NotOnGroupError(
+            f"{name} must be a homogeneous transform with last row [0, 0, 0, 1]; "
+            f"got a last row off by {row_err:.3g}"
+        )
+    check_rotation(g[..., :3, :3], f"rotation block of {name}", tol)
+    return g

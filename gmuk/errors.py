@@ -1,0 +1,80 @@
+"""Exceptions raised by gmuk.
+
+Every error gmuk raises on bad input is a :class:`GmukError`. Each subclass also derives
+from the matching built-in exception (``ValueError`` or ``TypeError``), so code that
+already catches those keeps working. Messages state what was expected and what came in.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "ConstraintError",
+    "DefinitionError",
+    "EulerSequenceError",
+    "FileFormatError",
+    "GmukError",
+    "InconsistentConstraintsError",
+    "InertiaError",
+    "NonFiniteError",
+    "NotOnGroupError",
+    "ShapeError",
+    "SimulationError",
+]
+
+
+class GmukError(Exception):
+    """Base class of every error raised by gmuk."""
+
+
+class ShapeError(GmukError, ValueError):
+    """An array has the wrong shape (message gives the expected and received shapes)."""
+
+
+class NonFiniteError(GmukError, ValueError):
+    """An array holds NaN or infinity where finite numbers are required."""
+
+
+class NotOnGroupError(GmukError, ValueError):
+    """A matrix is not a rotation matrix or not a homogeneous SE(3) transformation."""
+
+
+class EulerSequenceError(GmukError, ValueError):
+    """An unsupported Euler-angle sequence was requested."""
+
+
+class InertiaError(GmukError, ValueError):
+    """A mass or inertia tensor is not physical (m <= 0, J not SPD, triangle inequality)."""
+
+
+class DefinitionError(GmukError, ValueError):
+    """A system definition is invalid; ``problems`` lists every problem found."""
+
+    def __init__(self, problems: list[str] | str) -> None:
+        self.problems = [problems] if isinstance(problems, str) else list(problems)
+        if len(self.problems) == 1:
+            msg = self.problems[0]
+        else:
+            msg = f"{len(self.problems)} problems in the definition:\n" + "\n".join(
+                f"  - {p}" for p in self.problems
+            )
+        super().__init__(msg)
+
+
+class ConstraintError(GmukError, ValueError):
+    """A constraint returned rows of the wrong shape or non-finite values."""
+
+
+class InconsistentConstraintsError(GmukError, ValueError):
+    """The constraint equations A V̇ = b have no solution (residual above tolerance)."""
+
+
+class FileFormatError(GmukError, ValueError):
+    """A data file is malformed; the message names the file, the line and what was expected."""
+
+
+class SimulationError(GmukError, RuntimeError):
+    """A simulation failed; ``trajectory`` holds every step computed before the failure."""
+
+    def __init__(self, message: str, trajectory: object | None = None) -> None:
+        super().__init__(message)
+        self.trajectory = trajectory

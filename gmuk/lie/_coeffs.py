@@ -1,0 +1,91 @@
+"""Scalar coefficient functions of the SO(3)/SE(3) closed forms, accurate for every angle.
+
+Each function takes an array of angles θ ≥ 0 (rad) and returns an array of the same shape.
+Where the closed form cancels catastrophically (θ → 0) a Taylor series in θ² is used below
+``_SERIES_BELOW``; the series converge for θ < 2π and are truncated where the next term is
+below 1e-20 relative at the switch-over, so both branches agree to round-off there.
+The series coefficients are exact rationals (derived symbolically; see ERRATA.md,
+"Numerically fragile", for F₁ and F₂ of McCann (2020), Eqs. 21–22).
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from math import factorial
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+_SERIES_BELOW = 1.0
+
+# C(θ) = (θ − sin θ)/θ³ = Σ_k (−1)^k θ^{2k} / (2k+3)!
+_C_SERIES = np.array([(-1) ** k / factorial(2 * k + 3) for k in range(11)])[::-1].copy()
+
+# D(θ) = (1 − (θ/2) cot(θ/2))/θ² = 1/12 + θ²/720 + … (coefficients from the Bernoulli numbers)
+_D_TERMS = [
+    Fraction(1, 12),
+    Fraction(1, 720),
+    Fraction(1, 30240),
+    Fraction(1, 1209600),
+    Fraction(1, 47900160),
+    Fraction(691, 1307674368000),
+    Fraction(1, 74724249600),
+    Fraction(3617, 10670622842880000),
+    Fraction(43867, 5109094217170944000),
+    Fraction(174611, 802857662698291200000),
+    Fraction(77683, 14101100039391805440000),
+    Fraction(236364091, 1693824136731743669452800000),
+]
+# E(θ) = (D(θ) − 1/12)/θ²: the same series shifted by one term.
+_E_SERIES = np.array([float(c) for c in _D_TERMS[1:]])[::-1].copy()
+_D_SERIES = np.array([float(c) for c in _D_TERMS])[::-1].copy()
+
+
+def _split(theta: FloatArray) -> tuple[NDArray[np.bool_], FloatArray, FloatArray]:
+    """Return (small-mask, θ² for the series, θ clipped away from 0 for the closed form)."""
+    small = theta < _SERIES_BELOW
+    return small, theta * theta, np.where(small, _SERIES_BELOW, theta)
+
+
+def sinc(theta: FloatArray) -> FloatArray:
+    """sin θ / θ, with value 1 at θ = 0."""
+    return np.sinc(theta / np.pi)
+
+
+def one_minus_cos_over_sq(theta: FloatArray) -> FloatArray:
+    """B(θ) = (1 − cos θ)/θ² = ½ sinc²(θ/2), with value ½ at θ = 0 (no cancellation)."""
+    s = np.sinc(theta / (2.0 * np.pi))
+    return 0.5 * s * s
+
+
+def theta_minus_sin_over_cube(theta: FloatArray) -> FloatArray:
+    """C(θ) = (θ − sin θ)/θ³, with value 1/6 at θ = 0."""
+    small, t2, tc = _split(theta)
+    closed = (tc - np.sin(tc)) / (tc * tc * tc)
+    return np.where(small, np.polyval(_C_SERIES, t2), closed)
+
+
+def dexp_inv_d(theta: FloatArray) -> FloatArray:
+    """D(θ) = (1 − (θ/2) cot(θ/2))/θ², with value 1/12 at θ = 0 (singular at θ = 2π)."""
+    small, t2, tc = _split(theta)
+    h = 0.5 * tc
+    closed = (1.0 - h / np.tan(h)) / (tc * tc)
+    return np.where(small, np.polyval(_D_SERIES, t2), closed)
+
+
+def dexp_inv_f1_f2(theta: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """F₁(θ) and F₂(θ) of McCann (2020), Eqs. 21–22, without cancellation.
+
+    Rewritten exactly in terms of D and E = (D − 1/12)/θ²:
+    ``F₁ = 5D/2 − θ²D²/2 − 1/8`` and ``F₂ = 3E/2 − D²/2``, so that
+    ``F₁ − θ²F₂ = D`` holds to round-off. Limits: F₁(0) = 1/12, F₂(0) = −1/720.
+    """
+    small, t2, tc = _split(theta)
+    d = dexp_inv_d(theta)
+    e_closed = (dexp_inv_d(tc) - 1.0 / 12.0) / (tc * tc)
+    e = np.where(small, np.polyval(_E_SERIES, t2), e_closed)
+    f1 = 2.5 * d - 0.5 * t2 * d * d - 0.125
+    f2 = 1.5 * e - 0.5 * d * d
+    return f1, f2

@@ -1,0 +1,156 @@
+"""The rotation group SO(3) and its algebra so(3), as pure functions of numpy arrays.
+
+Every function accepts leading batch axes: a rotation vector is ``(..., 3)``, a rotation
+matrix ``(..., 3, 3)``. Rotation matrices here are ``R_NB``: they map body (B) components
+to inertial (N) components.
+
+References
+----------
+McCann (2020), Eq. (13) (the cross-product matrix). Exponential and logarithm: the
+Rodrigues formula, e.g. Murray, Li & Sastry, *A Mathematical Introduction to Robotic
+Manipulation* (1994), §2.2.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray, as_array, check_rotation
+from gmuk.errors import NotOnGroupError
+from gmuk.lie import _coeffs
+
+__all__ = ["exp", "hat", "log", "vee"]
+
+# hat(w) = w @ _GEN.reshape(3, 9): the generators E_k = hat(e_k), stacked.
+_GEN = np.zeros((3, 3, 3))
+_GEN[0, 2, 1], _GEN[0, 1, 2] = 1.0, -1.0
+_GEN[1, 0, 2], _GEN[1, 2, 0] = 1.0, -1.0
+_GEN[2, 1, 0], _GEN[2, 0, 1] = 1.0, -1.0
+_GEN_FLAT = _GEN.reshape(3, 9)
+
+#: Tolerance for the skew-symmetry check in :func:`vee` (relative to the largest entry).
+SKEW_TOL = 1e-9
+
+
+def _hat(w: FloatArray) -> FloatArray:
+    return (w @ _GEN_FLAT).reshape((*w.shape[:-1], 3, 3))
+
+
+def _vee(W: FloatArray) -> FloatArray:
+    return np.stack([W[..., 2, 1], W[..., 0, 2], W[..., 1, 0]], axis=-1)
+
+
+def hat(w: Any) -> FloatArray:
+    """Cross-product matrix ``w^×`` of a 3-vector, so that ``hat(w) @ x == cross(w, x)``.
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+        Angular vector (e.g. ω in rad/s, or a rotation vector in rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        The skew-symmetric matrix of McCann (2020), Eq. (13).
+    """
+    return _hat(as_array(w, (3,), "w"))
+
+
+def vee(W: Any) -> FloatArray:
+    """Inverse of :func:`hat`: the 3-vector of a skew-symmetric matrix.
+
+    Parameters
+    ----------
+    W : array_like, shape (..., 3, 3)
+        Skew-symmetric matrices.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+
+    Raises
+    ------
+    NotOnGroupError
+        If ``W`` is not skew-symmetric to ``SKEW_TOL`` relative to its largest entry
+        (gmuk does not silently drop the symmetric part).
+    """
+    W = as_array(W, (3, 3), "W")
+    asym = np.abs(W + np.swapaxes(W, -1, -2)).max(initial=0.0)
+    scale = max(1.0, float(np.abs(W).max(initial=0.0)))
+    if asym > SKEW_TOL * scale:
+        raise NotOnGroupError(
+            f"W must be skew-symmetric (W + Wᵀ = 0 to {SKEW_TOL:g} relative); "
+            f"got max|W + Wᵀ| = {asym:.3g}"
+        )
+    return _vee(W)
+
+
+def _exp(w: FloatArray) -> FloatArray:
+    theta = np.sqrt(np.einsum("...i,...i->...", w, w))
+    a = _coeffs.sinc(theta)[..., None, None]
+    b = _coeffs.one_minus_cos_over_sq(theta)[..., None, None]
+    c = np.cos(theta)[..., None, None]
+    return c * np.eye(3) + a * _hat(w) + b * (w[..., :, None] * w[..., None, :])
+
+
+def exp(w: Any) -> FloatArray:
+    """Exponential map so(3) → SO(3) (Rodrigues), accurate for every angle.
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+        Rotation vector θ e (rad): axis e times angle θ.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        ``R = cos θ I + (sin θ/θ) w^× + ((1 − cos θ)/θ²) w wᵀ``; no series switch is
+        needed because both coefficients are evaluated as sinc functions.
+    """
+    return _exp(as_array(w, (3,), "w"))
+
+
+def _log(R: FloatArray) -> FloatArray:
+    c = 0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0)
+    s_vec = 0.5 * _vee(R - np.swapaxes(R, -1, -2))  # = sin θ · e
+    s = np.sqrt(np.einsum("...i,...i->...", s_vec, s_vec))
+    theta = np.arctan2(s, np.clip(c, -1.0, 1.0))
+    # Regular branch: w = θ/sin θ · s_vec. θ/s = 1/sinc(θ) is accurate down to θ = 0.
+    w = s_vec / _coeffs.sinc(theta)[..., None]
+    # Near π the antisymmetric part vanishes; take the axis from the symmetric part instead:
+    # (R + Rᵀ)/2 − c I = (1 − c) e eᵀ. Use the column with the largest diagonal entry.
+    near_pi = (c < 0.0) & (s < 0.1)
+    if np.any(near_pi):
+        S = 0.5 * (R + np.swapaxes(R, -1, -2)) - c[..., None, None] * np.eye(3)
+        k = np.argmax(np.diagonal(S, axis1=-2, axis2=-1), axis=-1)
+        col = np.take_along_axis(S, k[..., None, None], axis=-1)[..., 0]
+        skk = np.take_along_axis(np.diagonal(S, axis1=-2, axis2=-1), k[..., None], axis=-1)
+        e = col / np.sqrt(skk * (1.0 - c[..., None]))
+        sign = np.where(np.einsum("...i,...i->...", e, s_vec) < 0.0, -1.0, 1.0)
+        w = np.where(near_pi[..., None], (sign * theta)[..., None] * e, w)
+    return w
+
+
+def log(R: Any) -> FloatArray:
+    """Logarithm SO(3) → so(3), the rotation vector with angle θ ∈ [0, π].
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+        Rotation matrices (checked: RᵀR = I to 1e-9 and det = +1).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Rotation vector θ e (rad). At exactly θ = π both ±π e are valid; the sign is
+        then chosen from the largest axis component being positive.
+
+    Notes
+    -----
+    θ comes from ``atan2(|vee(R − Rᵀ)|/2, (tr R − 1)/2)``, accurate at every angle. The axis
+    comes from the antisymmetric part, except near π (sin θ < 0.1, cos θ < 0) where it is
+    read from the symmetric part so that a rotation by exactly π works.
+    """
+    return _log(check_rotation(R, "R"))
