@@ -13,7 +13,9 @@ __all__ = [
     "EulerSequenceError",
     "FileFormatError",
     "GmukError",
+    "GmukWarning",
     "InconsistentConstraintsError",
+    "InconsistentConstraintsWarning",
     "InertiaError",
     "NonFiniteError",
     "NotOnGroupError",
@@ -78,3 +80,11 @@ class SimulationError(GmukError, RuntimeError):
     def __init__(self, message: str, trajectory: object | None = None) -> None:
         super().__init__(message)
         self.trajectory = trajectory
+
+
+class GmukWarning(UserWarning):
+    """Base class of gmuk's warnings."""
+
+
+class InconsistentConstraintsWarning(GmukWarning, RuntimeWarning):
+    """A ν̇ = b had no exact solution; the least-squares constraint acceleration was used."""

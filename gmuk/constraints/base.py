@@ -1,0 +1,150 @@
+"""The Constraint base class and Baumgarte gains.
+
+A constraint involves some bodies and, at a :class:`gmuk.State`, returns its rows (A, b) of
+``A ν̇ = b`` (McCann 2020, Eqs. 1 and 63), where the columns of A are the velocities of
+``self.bodies`` in the order given (6 per rigid body [ω; v], 3 per point mass, 1 per slack
+coordinate). The System places the columns into the global A.
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray
+from gmuk.errors import DefinitionError
+
+if TYPE_CHECKING:
+    from gmuk.bodies import Body
+    from gmuk.state import State
+
+__all__ = ["Baumgarte", "Constraint"]
+
+
+@dataclass(frozen=True)
+class Baumgarte:
+    """Baumgarte stabilisation gains, ``Φ̈ + α Φ̇ + β Φ = 0`` (McCann 2020, Eq. 4).
+
+    Parameters
+    ----------
+    alpha : float or array_like, shape (s,)
+        Velocity gain(s) α (1/s), ≥ 0.
+    beta : float or array_like, shape (s,)
+        Position gain(s) β (1/s²), ≥ 0. Critical damping: α = 2√β.
+
+    Nonholonomic (velocity-level) constraints use α only: ``Ψ̇ + α Ψ = 0``.
+    """
+
+    alpha: Any = 0.0
+    beta: Any = 0.0
+
+    def __post_init__(self) -> None:
+        for label in ("alpha", "beta"):
+            v = np.asarray(getattr(self, label), dtype=float)
+            if v.ndim > 1 or not np.all(np.isfinite(v)) or np.any(v < 0.0):
+                raise DefinitionError(
+                    f"Baumgarte {label} must be a finite scalar or 1-D array ≥ 0; got {v!r}"
+                )
+            object.__setattr__(self, label, v)
+
+    @staticmethod
+    def critical(omega_n: float) -> Baumgarte:
+        """Critically damped gains for natural frequency ``omega_n`` (rad/s)."""
+        return Baumgarte(alpha=2.0 * omega_n, beta=omega_n**2)
+
+
+class Constraint(abc.ABC):
+    """A set of s constraint rows ``A ν̇ = b`` on some bodies.
+
+    Subclass it and implement :meth:`rows`. The bodies are given as :class:`gmuk.Body`
+    objects or names; the System checks that they exist. A constraint is frozen once it is
+    handed to a System (its attributes can no longer be set).
+
+    Parameters
+    ----------
+    bodies : sequence of Body or str
+        The bodies whose velocities make the columns of A, in this order.
+    name : str, optional
+        Label used in error messages and diagnostics.
+
+    Examples
+    --------
+    >>> class Rows(Constraint):
+    ...     def __init__(self, bodies, A, b):
+    ...         super().__init__(bodies)
+    ...         self.A, self.b = A, b
+    ...     def rows(self, state):
+    ...         return self.A, self.b
+    """
+
+    def __init__(self, bodies: Sequence[Body | str], *, name: str | None = None) -> None:
+        if isinstance(bodies, str) or not isinstance(bodies, Sequence):
+            bodies = [bodies]  # type: ignore[list-item]
+        if len(bodies) == 0:
+            raise DefinitionError(f"{type(self).__name__} needs at least one body")
+        object.__setattr__(self, "_bodies", tuple(bodies))
+        object.__setattr__(self, "_name", name or type(self).__name__)
+        object.__setattr__(self, "_frozen", False)
+
+    @property
+    def bodies(self) -> tuple[Body | str, ...]:
+        """The bodies (objects or names) this constraint acts on, in column order."""
+        return self._bodies  # type: ignore[no-any-return]
+
+    @property
+    def body_names(self) -> tuple[str, ...]:
+        """Names of :attr:`bodies`."""
+        return tuple(b if isinstance(b, str) else b.name for b in self.bodies)
+
+    @property
+    def name(self) -> str:
+        """Label of the constraint."""
+        return self._name  # type: ignore[no-any-return]
+
+    @abc.abstractmethod
+    def rows(self, state: State) -> tuple[Any, Any]:
+        """Rows of the constraint at ``state``.
+
+        Returns
+        -------
+        A : array_like, shape (s, Σ dof of self.bodies)
+        b : array_like, shape (s,)
+            In SI units of acceleration (rad/s², m/s², …) times those of A.
+        """
+
+    def _freeze(self) -> None:
+        object.__setattr__(self, "_frozen", True)
+
+    def __setattr__(self, key: str, value: Any) -> None:
+        if getattr(self, "_frozen", False):
+            raise AttributeError(
+                f"{self.name} is frozen: it belongs to a System; build a new constraint instead"
+            )
+        object.__setattr__(self, key, value)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(bodies={list(self.body_names)}, name={self.name!r})"
+
+
+def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[FloatArray, FloatArray]:
+    """Check and convert a constraint's (A, b); raise ConstraintError with details."""
+    from gmuk.errors import ConstraintError
+
+    A = np.asarray(A, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if A.ndim == 1:
+        A = A[None, :]
+    if b.ndim == 0:
+        b = b[None]
+    if A.ndim != 2 or A.shape[1] != n_cols or b.shape != (A.shape[0],):
+        raise ConstraintError(
+            f"{who}: rows() must return A of shape (s, {n_cols}) and b of shape (s,); "
+            f"got A {A.shape} and b {b.shape}"
+        )
+    if not (np.isfinite(A).all() and np.isfinite(b).all()):
+        raise ConstraintError(f"{who}: rows() returned NaN or inf in A or b")
+    return A, b

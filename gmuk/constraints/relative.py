@@ -1,0 +1,129 @@
+"""Constraints on the relative twist of one rigid body with respect to another.
+
+For bodies L (reference) and B with ``g_B = g_L g_{B/L}``, the relative twist is
+``V_{B/L} = V_B − Ad_{g_{B/L}⁻¹} V_L`` (McCann 2020, Eq. 73 and Section 4.1.3) and
+
+``V̇_{B/L} = V̇_B − Ad_{g_{B/L}⁻¹} V̇_L + ad_{V_{B/L}} Ad_{g_{B/L}⁻¹} V_L``.
+
+A :class:`RelativeConstraint` prescribes ``S V̇_{B/L} = S a_des(t)`` for a selection matrix S,
+so that with columns ordered [V_L, V_B]:
+
+``A = [−S Ad_{g_{B/L}⁻¹}, S]``, ``b = S (a_des − ad_{V_{B/L}} Ad_{g_{B/L}⁻¹} V_L)``,
+
+which is the lower block of the two-body A, b at the end of Section 4.1.3 (the
+virtual-spacecraft pair: S = [0₅ₓ₁ I₅] leaves B free about its first axis).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray
+from gmuk.constraints.base import Baumgarte, Constraint
+from gmuk.errors import ConstraintError
+from gmuk.lie import se3
+
+if TYPE_CHECKING:
+    from gmuk.bodies import Body
+    from gmuk.state import State
+
+__all__ = ["RelativeConstraint", "relative_twist"]
+
+
+def relative_twist(
+    g_L: FloatArray, V_L: FloatArray, g_B: FloatArray, V_B: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Relative pose and twist of B with respect to L.
+
+    Returns
+    -------
+    g_BL : ndarray (4, 4)
+        ``g_{B/L} = g_L⁻¹ g_B``.
+    V_BL : ndarray (6,)
+        ``V_{B/L} = V_B − Ad_{g_{B/L}⁻¹} V_L``, expressed in B.
+    AdV_L : ndarray (6,)
+        ``Ad_{g_{B/L}⁻¹} V_L``: L's twist expressed in B.
+    """
+    g_BL = se3._inverse(g_L) @ g_B
+    Ad_inv = se3._Ad(se3._inverse(g_BL))
+    AdV_L = Ad_inv @ V_L
+    return g_BL, V_B - AdV_L, AdV_L
+
+
+class RelativeConstraint(Constraint):
+    """Prescribe selected components of the relative acceleration of B with respect to L.
+
+    Parameters
+    ----------
+    body : Body or str
+        The constrained rigid body B.
+    relative_to : Body or str
+        The reference rigid body L (columns of A: L first, then B).
+    free_axes : sequence of int, optional
+        Components of V_{B/L} = [ω; v] (0–5) left free; the others are constrained.
+        ``free_axes=[0]`` is the virtual-spacecraft pair of McCann (2020), Section 4.1.3.
+    S : array_like, shape (s, 6), optional
+        Selection matrix, instead of ``free_axes``.
+    acceleration : callable t ↦ (6,), optional
+        Desired relative acceleration a_des(t) (rad/s², m/s²); zero by default.
+    baumgarte : Baumgarte, optional
+        ``alpha`` drives S V_{B/L} to S ∫a_des (zero by default) at rate α: velocity-level.
+    name : str, optional
+    """
+
+    def __init__(
+        self,
+        body: Body | str,
+        relative_to: Body | str,
+        *,
+        free_axes: Sequence[int] | None = None,
+        S: Any = None,
+        acceleration: Callable[[float], Any] | None = None,
+        velocity: Callable[[float], Any] | None = None,
+        baumgarte: Baumgarte | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__([relative_to, body], name=name)
+        if (free_axes is None) == (S is None):
+            raise ConstraintError("give exactly one of free_axes and S")
+        if S is None:
+            assert free_axes is not None
+            bad = [a for a in free_axes if a not in range(6)]
+            if bad or len(set(free_axes)) != len(free_axes):
+                raise ConstraintError(
+                    f"free_axes must be distinct integers in 0..5; got {free_axes}"
+                )
+            S = np.eye(6)[[i for i in range(6) if i not in free_axes]]
+        S = np.asarray(S, dtype=float)
+        if S.ndim != 2 or S.shape[1] != 6 or not np.isfinite(S).all():
+            raise ConstraintError(f"S must be a finite (s, 6) matrix; got shape {S.shape}")
+        self.S = S
+        self.acceleration = acceleration
+        self.velocity = velocity
+        self.baumgarte = baumgarte
+
+    def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
+        """(A, b) with columns [V_L, V_B]."""
+        L, B = self.bodies
+        g_BL, V_BL, AdV_L = relative_twist(
+            state.pose(L), state.twist(L), state.pose(B), state.twist(B)
+        )
+        Ad_inv = se3._Ad(se3._inverse(g_BL))
+        A = np.hstack([-self.S @ Ad_inv, self.S])
+        a_des = (
+            np.zeros(6)
+            if self.acceleration is None
+            else np.asarray(self.acceleration(state.t), dtype=float)
+        )
+        b = self.S @ (a_des - se3._ad(V_BL) @ AdV_L)
+        if self.baumgarte is not None:
+            v_des = (
+                np.zeros(6)
+                if self.velocity is None
+                else np.asarray(self.velocity(state.t), dtype=float)
+            )
+            b = b - self.baumgarte.alpha * (self.S @ (V_BL - v_des))
+        return A, b

@@ -1,0 +1,89 @@
+"""The Controller base class.
+
+A controller adds a wrench u to each of its bodies from the state (McCann 2020, Eq. 10b,
+the "u" beside τ), and may carry internal states z (e.g. the integral of an error) that the
+integrator advances with ż from :meth:`Controller.control`. Control wrenches act on the
+plant: the Udwadia–Kalaba solve does not see them (it computes the constraint acceleration of
+the nominal, modeled system; Chapter 5).
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray
+from gmuk.errors import DefinitionError
+
+if TYPE_CHECKING:
+    from gmuk.bodies import Body
+    from gmuk.state import State
+
+__all__ = ["Controller"]
+
+
+class Controller(abc.ABC):
+    """A feedback law producing control wrenches.
+
+    Parameters
+    ----------
+    bodies : sequence of Body or str
+        The bodies it acts on.
+    n_states : int
+        Number of internal states (default 0).
+    name : str, optional
+    """
+
+    def __init__(
+        self, bodies: Sequence[Body | str], *, n_states: int = 0, name: str | None = None
+    ) -> None:
+        if isinstance(bodies, str):
+            bodies = [bodies]
+        if int(n_states) != n_states or n_states < 0:
+            raise DefinitionError(f"n_states must be an integer ≥ 0; got {n_states!r}")
+        object.__setattr__(self, "_bodies", tuple(bodies))
+        object.__setattr__(self, "n_states", int(n_states))
+        object.__setattr__(self, "_name", name or type(self).__name__)
+        object.__setattr__(self, "_frozen", False)
+
+    @property
+    def bodies(self) -> tuple[Body | str, ...]:
+        """The bodies it acts on."""
+        return self._bodies  # type: ignore[no-any-return]
+
+    @property
+    def name(self) -> str:
+        """Label of the controller."""
+        return self._name  # type: ignore[no-any-return]
+
+    def initial_state(self) -> FloatArray:
+        """Initial internal state z(0), shape (n_states,); zeros unless overridden."""
+        return np.zeros(self.n_states)
+
+    @abc.abstractmethod
+    def control(self, state: State, z: FloatArray) -> tuple[Sequence[Any], Any]:
+        """Control wrenches and internal-state rates.
+
+        Parameters
+        ----------
+        state : State
+        z : ndarray, shape (n_states,)
+
+        Returns
+        -------
+        u : sequence of arrays
+            One per body of :attr:`bodies`: [u_L; u_f] (6,) in the body frame for a rigid
+            body (N·m, N), f_N (3,) for a point mass.
+        z_dot : array_like, shape (n_states,)
+        """
+
+    def _freeze(self) -> None:
+        object.__setattr__(self, "_frozen", True)
+
+    def __setattr__(self, key: str, value: Any) -> None:
+        if getattr(self, "_frozen", False):
+            raise AttributeError(f"{self.name} is frozen: it belongs to a System")
+        object.__setattr__(self, key, value)

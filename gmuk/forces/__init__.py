@@ -1,0 +1,6 @@
+"""Force models: body-frame wrenches from gravity, springs, applied loads, plugins."""
+
+from gmuk.forces.base import ForceModel
+from gmuk.forces.mechanical import AppliedWrench, SpringDamper, UniformGravity
+
+__all__ = ["AppliedWrench", "ForceModel", "SpringDamper", "UniformGravity"]

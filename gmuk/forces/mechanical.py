@@ -1,0 +1,189 @@
+"""Simple mechanical force models: applied wrenches, springs and dampers, uniform gravity."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray, as_array
+from gmuk.errors import DefinitionError
+from gmuk.forces.base import ForceModel
+
+if TYPE_CHECKING:
+    from gmuk.bodies import Body
+    from gmuk.state import State
+
+__all__ = ["AppliedWrench", "SpringDamper", "UniformGravity"]
+
+STANDARD_GRAVITY = 9.80665  # m/s², CGPM 1901
+
+
+class AppliedWrench(ForceModel):
+    """A given wrench on one body: constant or a function of time.
+
+    Parameters
+    ----------
+    body : Body or str
+    wrench : array_like (6,) or (3,), or callable t ↦ array
+        [L; f] for a rigid body (N·m, N), f for a point mass (N).
+    frame : {"body", "inertial"}
+        Frame of the given components. Inertial components of a rigid body's wrench are
+        rotated into the body frame (torque about the centre of mass).
+    modeled : bool
+        Whether the constraint solve knows it (default True).
+    name : str, optional
+    """
+
+    def __init__(
+        self,
+        body: Body | str,
+        wrench: Any,
+        *,
+        frame: str = "body",
+        modeled: bool = True,
+        name: str | None = None,
+    ) -> None:
+        super().__init__([body], modeled=modeled, name=name)
+        if frame not in ("body", "inertial"):
+            raise DefinitionError(f"frame must be 'body' or 'inertial'; got {frame!r}")
+        if not callable(wrench):
+            w = np.asarray(wrench, dtype=float)
+            if w.shape not in ((6,), (3,)) or not np.isfinite(w).all():
+                raise DefinitionError(
+                    f"wrench must be a finite (6,) or (3,) array or a callable; got shape {w.shape}"
+                )
+        self._fun: Callable[[float], Any] = wrench if callable(wrench) else (lambda t, w=w: w)
+        self.frame = frame
+
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
+        """The wrench at time t, in the body frame (or f_N for a point mass)."""
+        w = np.asarray(self._fun(t), dtype=float)
+        if body.kind == "rigid" and self.frame == "inertial":
+            Rt = g_NB[:3, :3].T
+            return np.concatenate([Rt @ w[:3], Rt @ w[3:]])
+        return w
+
+
+class UniformGravity(ForceModel):
+    """Weight in a uniform field: f_N = m g_N (no torque about the centre of mass).
+
+    Parameters
+    ----------
+    g_N : array_like, shape (3,)
+        Gravitational acceleration in N (m/s²); default (0, 0, −9.80665).
+    bodies : sequence, optional
+    """
+
+    def __init__(
+        self,
+        g_N: Any = (0.0, 0.0, -STANDARD_GRAVITY),
+        *,
+        bodies: Sequence[Body | str] | None = None,
+        modeled: bool = True,
+    ) -> None:
+        super().__init__(bodies, modeled=modeled)
+        self.g_N = as_array(g_N, (3,), "g_N", batch=False)
+
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
+        """[0; m Rᵀ g_N] for a rigid body, m g_N for a point mass."""
+        m = float(body.mass)  # type: ignore[attr-defined]
+        if body.kind == "rigid":
+            return np.concatenate([np.zeros(3), m * (g_NB[:3, :3].T @ self.g_N)])
+        return m * self.g_N
+
+
+class SpringDamper(ForceModel):
+    """A linear spring–damper between a point of body a and a point of body b (or a fixed
+    point of N).
+
+    The tension is ``T = k (ℓ − ℓ₀) + c ℓ̇`` along the line between the attachment points;
+    it pulls them together when positive. Forces act at the attachment points, so rigid
+    bodies also get the torque ``p × f`` about their centre of mass.
+
+    Parameters
+    ----------
+    body_a : Body or str
+    point_a : array_like (3,)
+        Attachment in a's body frame (m); ignored (use zeros) for a point mass.
+    body_b : Body or str or None
+        None to anchor at ``point_b`` given in N.
+    point_b : array_like (3,)
+        Attachment in b's body frame, or the anchor in N (m).
+    stiffness : float
+        k (N/m), ≥ 0.
+    damping : float
+        c (N·s/m), ≥ 0.
+    rest_length : float
+        ℓ₀ (m), ≥ 0.
+    """
+
+    def __init__(
+        self,
+        body_a: Body | str,
+        point_a: Any,
+        body_b: Body | str | None,
+        point_b: Any,
+        *,
+        stiffness: float,
+        damping: float = 0.0,
+        rest_length: float = 0.0,
+        modeled: bool = True,
+        name: str | None = None,
+    ) -> None:
+        bodies = [body_a] if body_b is None else [body_a, body_b]
+        super().__init__(bodies, modeled=modeled, name=name)
+        for label, v in (
+            ("stiffness", stiffness),
+            ("damping", damping),
+            ("rest_length", rest_length),
+        ):
+            if not (np.isfinite(v) and v >= 0):
+                raise DefinitionError(f"{label} must be finite and ≥ 0; got {v!r}")
+        self.point_a = as_array(point_a, (3,), "point_a", batch=False)
+        self.point_b = as_array(point_b, (3,), "point_b", batch=False)
+        self.k, self.c, self.l0 = float(stiffness), float(damping), float(rest_length)
+        self.anchored = body_b is None
+
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
+        """Not used: the spring couples two bodies, see :meth:`wrenches`."""
+        raise NotImplementedError  # pragma: no cover - wrenches() is overridden
+
+    @staticmethod
+    def _point(
+        state: State, body: Body, p_B: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """World position and velocity of a body point, and its lever arm in N."""
+        if body.kind == "rigid":
+            g, V = state.pose(body), state.twist(body)
+            R = g[:3, :3]
+            arm = R @ p_B
+            return g[:3, 3] + arm, R @ (V[3:] + np.cross(V[:3], p_B)), arm
+        return state.position(body).copy(), state.velocity(body).copy(), np.zeros(3)
+
+    def wrenches(self, state: State, bodies: Sequence[Body]) -> list[FloatArray]:
+        """Equal and opposite forces at the attachment points (with their torques)."""
+        x_a, v_a, _ = self._point(state, bodies[0], self.point_a)
+        if self.anchored:
+            x_b, v_b = self.point_b, np.zeros(3)
+        else:
+            x_b, v_b, _ = self._point(state, bodies[1], self.point_b)
+        d = x_b - x_a
+        length = float(np.linalg.norm(d))
+        if length == 0.0:
+            raise DefinitionError(f"{self.name}: attachment points coincide; direction undefined")
+        u = d / length
+        tension = self.k * (length - self.l0) + self.c * float(u @ (v_b - v_a))
+        f_a_N = tension * u
+        out = [self._to_body(state, bodies[0], self.point_a, f_a_N)]
+        if not self.anchored:
+            out.append(self._to_body(state, bodies[1], self.point_b, -f_a_N))
+        return out
+
+    @staticmethod
+    def _to_body(state: State, body: Body, p_B: FloatArray, f_N: FloatArray) -> FloatArray:
+        if body.kind != "rigid":
+            return f_N
+        f_B = state.pose(body)[:3, :3].T @ f_N
+        return np.concatenate([np.cross(p_B, f_B), f_B])

@@ -1,0 +1,575 @@
+"""The System: parts in, accelerations out.
+
+A :class:`System` takes bodies, constraints, force models and controllers once, validates
+them (reporting every problem in one :class:`gmuk.errors.DefinitionError`), freezes them,
+and builds the constant block-diagonal mass matrix. :meth:`System.accelerations` then maps a
+:class:`gmuk.State` to the free, constraint and total accelerations with the multipliers and
+diagnostics, and :meth:`System.simulate` integrates on SE(3)ⁿ × Rᵏ. The System stores no State.
+
+References
+----------
+McCann (2020), Eqs. (2)–(3) (point masses), (63)–(64) (rigid bodies on R⁶), (79)–(80) (T²SE(3)).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import scipy.linalg
+import scipy.sparse as sp
+
+from gmuk import uk
+from gmuk._validation import FloatArray, as_array, check_se3
+from gmuk.bodies import Body, RigidBody
+from gmuk.constraints.base import Constraint, as_rows
+from gmuk.constraints.relative import RelativeConstraint
+from gmuk.constraints.tangent_bundle import TangentBundleConstraint
+from gmuk.constraints.tracking import ConfigurationTracking
+from gmuk.control.base import Controller
+from gmuk.errors import (
+    DefinitionError,
+    InconsistentConstraintsError,
+    InconsistentConstraintsWarning,
+)
+from gmuk.forces.base import ForceModel
+from gmuk.lie import se3
+from gmuk.state import Layout, State
+
+if TYPE_CHECKING:
+    from gmuk.trajectory import Trajectory
+
+__all__ = ["Accelerations", "System"]
+
+#: Above this many degrees of freedom (or constraint rows), "auto" selects the sparse path.
+SPARSE_THRESHOLD = 300
+
+
+@dataclass(frozen=True, eq=False)
+class Accelerations:
+    """Accelerations and diagnostics at one state (vectors in System body order, length n_dof).
+
+    Attributes
+    ----------
+    free : ndarray (n_dof,)
+        ν̇_a: the unconstrained acceleration under the *modeled* forces
+        (V̇_a = 𝕀⁻¹(ad*_V 𝕀V + τ) for rigid bodies, Eq. 10b).
+    constraint : ndarray (n_dof,)
+        ν̇_c: the Udwadia–Kalaba constraint acceleration (Eq. 64 / Eq. 2).
+    extra : ndarray (n_dof,)
+        Acceleration from unmodeled forces and controllers (the UK solve does not see it).
+    total : ndarray (n_dof,)
+        ν̇ = free + constraint + extra.
+    constraint_force : ndarray (n_dof,)
+        M ν̇_c = Aᵀλ: the constraint wrench [L; f] of each rigid body in its body frame (the
+        thesis's "control"), the force of each point mass in N.
+    control_force, unmodeled_force : ndarray (n_dof,)
+        Controller wrenches u and unmodeled wrenches, same layout.
+    multipliers : ndarray (s,)
+        λ of Eq. 3, with constraint force Aᵀλ (Pinocchio's ``lambda_c``; −μ of the KKT form).
+    residual : float
+        ‖A(ν̇_a + ν̇_c) − b‖₂ (T²SE(3): relative ‖A g̈ B − C‖_F).
+    rank : int or None
+        Rank of A (None if not computed: sparse path with redundant rows, or T²SE(3)).
+    unreachable : float
+        T²SE(3) only: relative size of the part of Eq. 80's g̈_c outside g·se(3) (0 on R⁶).
+    z_dot : ndarray (n_control,)
+        Rates of the controllers' internal states.
+    """
+
+    layout: Layout
+    free: FloatArray
+    constraint: FloatArray
+    extra: FloatArray
+    total: FloatArray
+    constraint_force: FloatArray
+    control_force: FloatArray
+    unmodeled_force: FloatArray
+    multipliers: FloatArray
+    residual: float
+    rank: int | None
+    unreachable: float
+    z_dot: FloatArray
+
+    def of(self, body: Body | str, field: str = "total") -> FloatArray:
+        """The slice of a per-dof field (e.g. "total", "constraint_force") for one body."""
+        s = self.layout.slot(body)
+        return getattr(self, field)[s.offset : s.offset + s.dof]  # type: ignore[no-any-return]
+
+
+class System:
+    """Bodies, constraints, forces and controllers, assembled once.
+
+    Parameters
+    ----------
+    bodies : sequence of Body
+        Unique names. Their order is the order of ν, of A's columns and of the results.
+    constraints : sequence of Constraint
+    forces : sequence of ForceModel
+    controllers : sequence of Controller
+    sparse : {"auto", True, False}
+        Solve path: "auto" uses sparse linear algebra above ``SPARSE_THRESHOLD`` dof or rows.
+    strict : bool
+        Raise :class:`gmuk.errors.InconsistentConstraintsError` on inconsistent constraints
+        instead of warning.
+    consistency_tol : float
+        Constraints count as inconsistent when ‖A ν̇ − b‖ > tol · max(1, ‖b‖, ‖A ν̇_a‖).
+    rcond : float, optional
+        Relative singular-value cut-off for the rank of A M^{-1/2} (dense path).
+
+    Raises
+    ------
+    DefinitionError
+        Listing every problem found (duplicate names, unknown bodies, wrong kinds …).
+    """
+
+    def __init__(
+        self,
+        bodies: Sequence[Body],
+        constraints: Sequence[Constraint] = (),
+        forces: Sequence[ForceModel] = (),
+        controllers: Sequence[Controller] = (),
+        *,
+        sparse: bool | str = "auto",
+        strict: bool = False,
+        consistency_tol: float = 1e-8,
+        rcond: float | None = None,
+    ) -> None:
+        self.bodies = tuple(bodies)
+        self.constraints = tuple(constraints)
+        self.forces = tuple(forces)
+        self.controllers = tuple(controllers)
+        problems = self._validate()
+        if problems:
+            raise DefinitionError(problems)
+        if sparse not in ("auto", True, False):
+            raise DefinitionError(f"sparse must be 'auto', True or False; got {sparse!r}")
+        for part in (*self.constraints, *self.forces, *self.controllers):
+            part._freeze()
+        self.strict = bool(strict)
+        self.consistency_tol = float(consistency_tol)
+        self.rcond = rcond
+        n_ctrl = sum(c.n_states for c in self.controllers)
+        self.layout = Layout(
+            tuple(b.name for b in self.bodies),
+            tuple(b.kind for b in self.bodies),
+            tuple(b.dof for b in self.bodies),
+            n_ctrl,
+        )
+        self._by_name = {b.name: b for b in self.bodies}
+        self._build_mass()
+        self._build_index()
+        n_rows_hint = self.layout.n_dof  # rows are unknown until evaluated; dof is the proxy
+        self.sparse = (n_rows_hint > SPARSE_THRESHOLD) if sparse == "auto" else bool(sparse)
+        self.tangent_bundle = any(isinstance(c, TangentBundleConstraint) for c in self.constraints)
+
+    # ------------------------------------------------------------------ validation
+    def _validate(self) -> list[str]:
+        problems: list[str] = []
+        names: dict[str, int] = {}
+        for i, b in enumerate(self.bodies):
+            if not isinstance(b, Body):
+                problems.append(f"bodies[{i}] must be a gmuk.Body; got {type(b).__name__}")
+                continue
+            if b.name in names:
+                problems.append(
+                    f"duplicate body name {b.name!r} (bodies[{names[b.name]}] and bodies[{i}])"
+                )
+            names.setdefault(b.name, i)
+        if not self.bodies:
+            problems.append("a System needs at least one body")
+        kinds = {b.name: b.kind for b in self.bodies if isinstance(b, Body)}
+
+        def check_refs(
+            part: Any, label: str, refs: Iterable[Body | str], rigid_only: bool = False
+        ) -> None:
+            for ref in refs:
+                name = ref if isinstance(ref, str) else getattr(ref, "name", None)
+                if name not in kinds:
+                    problems.append(
+                        f"{label} refers to unknown body {name!r}; bodies are {sorted(kinds)}"
+                    )
+                elif not isinstance(ref, str) and self.bodies[names[name]] is not ref:
+                    problems.append(f"{label} refers to a different body object named {name!r}")
+                elif rigid_only and kinds[name] != "rigid":
+                    problems.append(f"{label} needs rigid bodies; {name!r} is a {kinds[name]} body")
+
+        n_tangent = 0
+        for i, c in enumerate(self.constraints):
+            if not isinstance(c, Constraint):
+                problems.append(
+                    f"constraints[{i}] must be a gmuk.Constraint; got {type(c).__name__}"
+                )
+                continue
+            rigid = isinstance(
+                c, (RelativeConstraint, ConfigurationTracking, TangentBundleConstraint)
+            )
+            check_refs(c, f"constraint {c.name!r}", c.bodies, rigid_only=rigid)
+            n_tangent += isinstance(c, TangentBundleConstraint)
+        if n_tangent and (n_tangent > 1 or len(self.constraints) > 1):
+            problems.append(
+                "a T²SE(3) System takes exactly one TangentBundleConstraint and no "
+                f"other constraint (Eq. 79 does not stack); got {n_tangent} of "
+                f"{len(self.constraints)} constraints"
+            )
+        for i, f in enumerate(self.forces):
+            if not isinstance(f, ForceModel):
+                problems.append(f"forces[{i}] must be a gmuk.ForceModel; got {type(f).__name__}")
+            elif f.bodies is not None:
+                check_refs(f, f"force {f.name!r}", f.bodies)
+        for i, ctl in enumerate(self.controllers):
+            if not isinstance(ctl, Controller):
+                problems.append(
+                    f"controllers[{i}] must be a gmuk.Controller; got {type(ctl).__name__}"
+                )
+            else:
+                check_refs(ctl, f"controller {ctl.name!r}", ctl.bodies)
+        return problems
+
+    # ------------------------------------------------------------------ set-up
+    def _build_mass(self) -> None:
+        blocks = [b.mass_matrix() for b in self.bodies]
+        self.mass_matrix = scipy.linalg.block_diag(*blocks)
+        rigid = [b for b in self.bodies if isinstance(b, RigidBody)]
+        self._J = np.array([b.inertia for b in rigid]).reshape(-1, 3, 3)
+        self._Jinv = np.linalg.inv(self._J) if rigid else self._J.copy()
+        self._m_rigid = np.array([b.mass for b in rigid])
+        euclid = [b for b in self.bodies if b.kind != "rigid"]
+        self._m_euclid = (
+            np.concatenate([np.full(b.dof, b.mass) for b in euclid]) if euclid else np.zeros(0)
+        )  # type: ignore[attr-defined]
+        inv_sqrt = [uk.matrix_power_spd(B, -0.5) for B in blocks]
+        self._Minv_sqrt = scipy.linalg.block_diag(*inv_sqrt)
+        self._Minv_sp = sp.csr_matrix(scipy.linalg.block_diag(*[np.linalg.inv(B) for B in blocks]))
+        self._Minv_sqrt_sp = sp.csr_matrix(self._Minv_sqrt)
+        if rigid:  # 𝕀̃^{-1/4} for the T²SE(3) solve: blkdiag(J^{-1/4}, m^{-1/4}) per body
+            self._I_tilde_m14 = scipy.linalg.block_diag(
+                *[
+                    scipy.linalg.block_diag(
+                        uk.matrix_power_spd(b.inertia, -0.25), [[b.mass**-0.25]]
+                    )
+                    for b in rigid
+                ]
+            )
+
+    def _build_index(self) -> None:
+        lay = self.layout
+        self._rigid_idx = (lay.rigid_offsets[:, None] + np.arange(6)).reshape(-1, 6)
+        self._constraint_cols = [lay.columns(c.bodies) for c in self.constraints]
+        self._force_bodies: list[list[Body]] = []
+        for f in self.forces:
+            if f.bodies is None:
+                bs = [b for b in self.bodies if b.kind != "slack"]
+            else:
+                bs = [self._resolve(r) for r in f.bodies]
+            self._force_bodies.append(bs)
+        self._ctrl_bodies = [[self._resolve(r) for r in c.bodies] for c in self.controllers]
+        offs = np.cumsum([0] + [c.n_states for c in self.controllers])
+        self._ctrl_slices = [
+            slice(int(a), int(b)) for a, b in zip(offs[:-1], offs[1:], strict=True)
+        ]
+
+    def _resolve(self, ref: Body | str) -> Body:
+        return self._by_name[ref if isinstance(ref, str) else ref.name]
+
+    # ------------------------------------------------------------------ states
+    def state(
+        self,
+        g: Mapping[str, Any] | None = None,
+        V: Mapping[str, Any] | None = None,
+        *,
+        r: Mapping[str, Any] | None = None,
+        v: Mapping[str, Any] | None = None,
+        s: Mapping[str, Any] | None = None,
+        s_dot: Mapping[str, Any] | None = None,
+        z: Any = None,
+        t: float = 0.0,
+    ) -> State:
+        """Build a validated State.
+
+        Parameters
+        ----------
+        g, V : mapping name → array
+            Pose g_NB (4, 4) and body twist [ω; v] (6,) of every rigid body.
+        r, v : mapping name → array
+            Position r_N and velocity v_N (3,) of every point mass (m, m/s).
+        s, s_dot : mapping name → float
+            Value and rate of every slack coordinate.
+        z : array_like, optional
+            Controllers' internal states, concatenated in controller order; their
+            ``initial_state()`` if omitted.
+        t : float
+            Time (s).
+
+        Every body's configuration and velocity must be given (nothing is defaulted
+        silently); unknown names are an error.
+        """
+        lay = self.layout
+        problems: list[str] = []
+        given = {
+            "g": dict(g or {}),
+            "V": dict(V or {}),
+            "r": dict(r or {}),
+            "v": dict(v or {}),
+            "s": dict(s or {}),
+            "s_dot": dict(s_dot or {}),
+        }
+        need = {"rigid": ("g", "V"), "point": ("r", "v"), "slack": ("s", "s_dot")}
+        for key, mapping in given.items():
+            for name in mapping:
+                if name not in self._by_name:
+                    problems.append(
+                        f"{key}[{name!r}]: no body of that name; bodies are {list(lay.names)}"
+                    )
+                elif key not in need[self._by_name[name].kind]:
+                    problems.append(
+                        f"{key}[{name!r}]: {name!r} is a "
+                        f"{self._by_name[name].kind} body; give "
+                        f"{' and '.join(need[self._by_name[name].kind])}"
+                    )
+        for b in self.bodies:
+            for key in need[b.kind]:
+                if b.name not in given[key]:
+                    problems.append(f"missing {key}[{b.name!r}]")
+        if problems:
+            raise DefinitionError(problems)
+        G = np.zeros((lay.n_rigid, 4, 4))
+        Vs = np.zeros((lay.n_rigid, 6))
+        x = np.zeros(lay.n_euclid)
+        xd = np.zeros(lay.n_euclid)
+        for b in self.bodies:
+            sl = lay.slot(b)
+            if b.kind == "rigid":
+                G[sl.index] = check_se3(given["g"][b.name], f"g[{b.name!r}]")
+                Vs[sl.index] = as_array(given["V"][b.name], (6,), f"V[{b.name!r}]", batch=False)
+            else:
+                kq, kv = need[b.kind]
+                shape = (sl.dof,)
+                x[sl.index : sl.index + sl.dof] = as_array(
+                    np.reshape(given[kq][b.name], -1), shape, f"{kq}[{b.name!r}]", batch=False
+                )
+                xd[sl.index : sl.index + sl.dof] = as_array(
+                    np.reshape(given[kv][b.name], -1), shape, f"{kv}[{b.name!r}]", batch=False
+                )
+        if z is None:
+            zz = np.concatenate([c.initial_state() for c in self.controllers] or [np.zeros(0)])
+        else:
+            zz = as_array(np.reshape(z, -1), (lay.n_control,), "z", batch=False)
+        tt = float(t)
+        if not np.isfinite(tt):
+            raise DefinitionError(f"t must be finite; got {t!r}")
+        return State(tt, G, Vs, x, xd, zz, lay)
+
+    # ------------------------------------------------------------------ dynamics
+    def _apply_Minv(self, Q: FloatArray) -> FloatArray:
+        out = np.empty_like(Q)
+        if self.layout.n_rigid:
+            Qr = Q[self._rigid_idx]
+            ar = np.empty_like(Qr)
+            ar[:, :3] = np.einsum("nij,nj->ni", self._Jinv, Qr[:, :3])
+            ar[:, 3:] = Qr[:, 3:] / self._m_rigid[:, None]
+            out[self._rigid_idx] = ar
+        if self.layout.n_euclid:
+            e = self.layout.euclid_offsets
+            out[e] = Q[e] / self._m_euclid
+        return out
+
+    def _apply_M(self, a: FloatArray) -> FloatArray:
+        out = np.empty_like(a)
+        if self.layout.n_rigid:
+            ar = a[self._rigid_idx]
+            Qr = np.empty_like(ar)
+            Qr[:, :3] = np.einsum("nij,nj->ni", self._J, ar[:, :3])
+            Qr[:, 3:] = ar[:, 3:] * self._m_rigid[:, None]
+            out[self._rigid_idx] = Qr
+        if self.layout.n_euclid:
+            e = self.layout.euclid_offsets
+            out[e] = a[e] * self._m_euclid
+        return out
+
+    def _gyroscopic(self, state: State) -> FloatArray:
+        """ad*_V 𝕀 V for every rigid body, as a generalized force (zeros elsewhere)."""
+        Q = np.zeros(self.layout.n_dof)
+        if self.layout.n_rigid:
+            w, v = state.V[:, :3], state.V[:, 3:]
+            Jw = np.einsum("nij,nj->ni", self._J, w)
+            bias = np.empty((self.layout.n_rigid, 6))
+            bias[:, :3] = _cross(Jw, w)
+            bias[:, 3:] = self._m_rigid[:, None] * _cross(v, w)
+            Q[self._rigid_idx] = bias
+        return Q
+
+    def _generalized_forces(
+        self, state: State
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        n = self.layout.n_dof
+        modeled, unmodeled, control = np.zeros(n), np.zeros(n), np.zeros(n)
+        for f, bodies in zip(self.forces, self._force_bodies, strict=True):
+            target = modeled if f.modeled else unmodeled
+            for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
+                self._add(target, body, w, f"force {f.name!r}")
+        z_dot = np.zeros(self.layout.n_control)
+        for c, bodies, sl in zip(
+            self.controllers, self._ctrl_bodies, self._ctrl_slices, strict=True
+        ):
+            u, zd = c.control(state, state.z[sl])
+            for body, w in zip(bodies, u, strict=True):
+                self._add(control, body, np.asarray(w, dtype=float), f"controller {c.name!r}")
+            z_dot[sl] = np.asarray(zd, dtype=float).reshape(-1)
+        return modeled, unmodeled, control, z_dot
+
+    def _add(self, target: FloatArray, body: Body, w: FloatArray, who: str) -> None:
+        s = self.layout.slot(body)
+        if w.shape != (s.dof,):
+            raise DefinitionError(
+                f"{who} returned shape {w.shape} for {body.kind} body "
+                f"{body.name!r}; expected ({s.dof},)"
+            )
+        target[s.offset : s.offset + s.dof] += w
+
+    def constraint_rows(self, state: State) -> tuple[FloatArray | sp.csr_matrix, FloatArray]:
+        """The stacked rows (A (s, n_dof), b (s,)) of all R⁶ constraints at ``state``
+        (a sparse CSR A on the sparse path)."""
+        blocks = []
+        for c, cols in zip(self.constraints, self._constraint_cols, strict=True):
+            Ai, bi = c.rows(state)
+            blocks.append((*as_rows(Ai, bi, cols.size, f"constraint {c.name!r}"), cols))
+        n = self.layout.n_dof
+        s = sum(bi.size for _, bi, _ in blocks)
+        b = np.concatenate([bi for _, bi, _ in blocks]) if blocks else np.zeros(0)
+        if self.sparse:
+            rows, cols_all, data = [], [], []
+            r0 = 0
+            for Ai, bi, cols in blocks:
+                rr, cc = np.meshgrid(np.arange(r0, r0 + bi.size), cols, indexing="ij")
+                rows.append(rr.ravel())
+                cols_all.append(cc.ravel())
+                data.append(Ai.ravel())
+                r0 += bi.size
+            if not blocks:
+                return sp.csr_matrix((0, n)), b
+            return sp.csr_matrix(
+                (np.concatenate(data), (np.concatenate(rows), np.concatenate(cols_all))),
+                shape=(s, n),
+            ), b
+        A = np.zeros((s, n))
+        r0 = 0
+        for Ai, bi, cols in blocks:
+            A[r0 : r0 + bi.size, cols] = Ai
+            r0 += bi.size
+        return A, b
+
+    def accelerations(self, state: State) -> Accelerations:
+        """Free, constraint and total accelerations at ``state``, with multipliers.
+
+        Parameters
+        ----------
+        state : State
+
+        Returns
+        -------
+        Accelerations
+
+        Warns
+        -----
+        InconsistentConstraintsWarning
+            When A ν̇ = b has no solution (residual above tolerance); raises
+            InconsistentConstraintsError instead in strict mode.
+        """
+        if state.layout is not self.layout and state.layout != self.layout:
+            raise DefinitionError("state belongs to another System (layouts differ)")
+        modeled, unmodeled, control, z_dot = self._generalized_forces(state)
+        a = self._apply_Minv(self._gyroscopic(state) + modeled)
+        extra = self._apply_Minv(unmodeled + control)
+        unreachable = 0.0
+        if self.tangent_bundle:
+            ac, lam, rank, residual, unreachable = self._solve_t2(state, a)
+        else:
+            ac, lam, rank, residual = self._solve_r6(state, a)
+        return Accelerations(
+            self.layout,
+            a,
+            ac,
+            extra,
+            a + ac + extra,
+            self._apply_M(ac),
+            control,
+            unmodeled,
+            lam,
+            residual,
+            rank,
+            unreachable,
+            z_dot,
+        )
+
+    def _solve_r6(
+        self, state: State, a: FloatArray
+    ) -> tuple[FloatArray, FloatArray, int | None, float]:
+        A, b = self.constraint_rows(state)
+        if b.size == 0:
+            return np.zeros_like(a), np.zeros(0), 0, 0.0
+        Aa = A @ a
+        r = b - Aa
+        if self.sparse:
+            ac, lam, rank = uk.solve_sparse(sp.csr_matrix(A), r, self._Minv_sp, self._Minv_sqrt_sp)
+        else:
+            ac, lam, rank = uk.solve_dense(A, r, self._Minv_sqrt, self.rcond)
+        residual = float(np.linalg.norm(A @ (a + ac) - b))
+        scale = max(1.0, float(np.linalg.norm(b)), float(np.linalg.norm(Aa)))
+        if residual > self.consistency_tol * scale:
+            msg = (
+                f"constraints are inconsistent at t = {state.t:.9g} s: ‖A ν̇ − b‖ = "
+                f"{residual:.3g} (tolerance {self.consistency_tol:g} × {scale:.3g}); the "
+                "least-squares constraint acceleration was used"
+            )
+            if self.strict:
+                raise InconsistentConstraintsError(msg)
+            warnings.warn(msg, InconsistentConstraintsWarning, stacklevel=3)
+        return ac, lam, rank, residual
+
+    def _solve_t2(
+        self, state: State, a: FloatArray
+    ) -> tuple[FloatArray, FloatArray, None, float, float]:
+        (c,) = self.constraints
+        assert isinstance(c, TangentBundleConstraint)
+        A, B, C = (np.asarray(x, dtype=float) for x in c.tangent_rows(state))
+        idx = [self.layout.slot(bd).index for bd in c.bodies]
+        g = state.g[idx]
+        Vh = se3._hat(state.V[idx])
+        a_r = a[self._rigid_idx[idx]]
+        gdd_a = g @ (Vh @ Vh + se3._hat(a_r))
+        Im14 = self._I_tilde_m14_for(idx)
+        V_dot_c, unreachable, residual = uk.solve_tangent_bundle(A, B, C, g, gdd_a, Im14)
+        ac = np.zeros_like(a)
+        ac[self._rigid_idx[idx]] = V_dot_c
+        return ac, np.zeros(0), None, residual, unreachable
+
+    def _I_tilde_m14_for(self, rigid_indices: list[int]) -> FloatArray:
+        sel = np.concatenate([np.arange(4 * i, 4 * i + 4) for i in rigid_indices])
+        return self._I_tilde_m14[np.ix_(sel, sel)]  # type: ignore[no-any-return]
+
+    # ------------------------------------------------------------------ simulation
+    def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:
+        """Integrate from ``state0`` over ``t_span``; see :func:`gmuk.integrate.simulate`."""
+        from gmuk.integrate import simulate
+
+        return simulate(self, state0, t_span, **options)
+
+    def __repr__(self) -> str:
+        return (
+            f"System(bodies={list(self.layout.names)}, constraints={len(self.constraints)}, "
+            f"forces={len(self.forces)}, controllers={len(self.controllers)}, "
+            f"sparse={self.sparse})"
+        )
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Row-wise cross product of (n, 3) arrays (np.cross is slow for small inputs)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out

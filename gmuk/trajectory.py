@@ -1,0 +1,287 @@
+"""Trajectory: the time-major record of a simulation, with per-body views and save/load.
+
+Arrays are time-first: ``t`` (N,), ``g_NB`` (N, n_rigid, 4, 4), ``V_B`` (N, n_rigid, 6),
+point-mass and slack coordinates ``x``/``xdot`` (N, n_euclid), controller states ``z``
+(N, n_control), and the recorded generalized quantities (N, n_dof) in System body order:
+``acceleration``, ``constraint_acceleration``, ``constraint_force`` (M ν̇_c: the constraint wrench [L; f] of each rigid
+body in its body frame), ``control_force`` and ``unmodeled_force``; ``multipliers`` (N, s),
+``residual`` (N,), ``rank`` (N,; −1 where not computed).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray
+from gmuk.errors import DefinitionError, FileFormatError
+from gmuk.lie import euler, so3
+from gmuk.state import Layout
+
+__all__ = ["BodyTrajectory", "Trajectory", "load_trajectory"]
+
+_FORMAT_VERSION = 1
+_ARRAYS = (
+    "t",
+    "g_NB",
+    "V_B",
+    "x",
+    "xdot",
+    "z",
+    "acceleration",
+    "constraint_acceleration",
+    "constraint_force",
+    "control_force",
+    "unmodeled_force",
+    "multipliers",
+    "residual",
+    "rank",
+)
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """The result of :meth:`gmuk.System.simulate`.
+
+    Attributes
+    ----------
+    t : ndarray (N,)
+        Times (s).
+    g_NB : ndarray (N, n_rigid, 4, 4)
+        Poses of the rigid bodies.
+    V_B : ndarray (N, n_rigid, 6)
+        Body twists [ω; v] (rad/s, m/s).
+    x, xdot : ndarray (N, n_euclid)
+        Point-mass positions r_N (m) / slack values, and their rates.
+    z : ndarray (N, n_control)
+        Controllers' internal states.
+    acceleration, constraint_acceleration : ndarray (N, n_dof)
+        Total acceleration ν̇ and constraint acceleration ν̇_c (Eq. 64).
+    constraint_force, control_force, unmodeled_force : ndarray (N, n_dof)
+        Constraint force M ν̇_c = Aᵀλ; controller and unmodeled forces.
+    multipliers : ndarray (N, s)
+    residual : ndarray (N,)
+        ‖A(ν̇_a + ν̇_c) − b‖ at each output.
+    rank : ndarray (N,) of int
+        Rank of A (−1 where not computed).
+    body_names, body_kinds : tuple of str
+    body_dofs : tuple of int
+    status : {"success", "interrupted", "failed"}
+    message : str
+    stats : dict
+        ``n_rhs`` (right-hand-side evaluations), ``n_steps``, ``n_rejected``, ``method``.
+    """
+
+    t: FloatArray
+    g_NB: FloatArray
+    V_B: FloatArray
+    x: FloatArray
+    xdot: FloatArray
+    z: FloatArray
+    acceleration: FloatArray
+    constraint_acceleration: FloatArray
+    constraint_force: FloatArray
+    control_force: FloatArray
+    unmodeled_force: FloatArray
+    multipliers: FloatArray
+    residual: FloatArray
+    rank: np.ndarray
+    body_names: tuple[str, ...]
+    body_kinds: tuple[str, ...]
+    body_dofs: tuple[int, ...]
+    status: str = "success"
+    message: str = ""
+    stats: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def layout(self) -> Layout:
+        """The body index of this trajectory."""
+        return Layout(self.body_names, self.body_kinds, self.body_dofs, self.z.shape[1])
+
+    @property
+    def success(self) -> bool:
+        """Whether the run reached the end of its time span."""
+        return self.status == "success"
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+    def body(self, name: str) -> BodyTrajectory:
+        """Per-body view (positions, attitudes, rates, wrenches) of body ``name``."""
+        if name not in self.body_names:
+            raise DefinitionError(f"no body named {name!r}; bodies are {list(self.body_names)}")
+        return BodyTrajectory(self, name)
+
+    def save(self, path: str | Path) -> Path:
+        """Save to a compressed ``.npz`` (arrays plus JSON metadata); returns the path."""
+        path = Path(path)
+        meta = {
+            "format_version": _FORMAT_VERSION,
+            "body_names": list(self.body_names),
+            "body_kinds": list(self.body_kinds),
+            "body_dofs": list(self.body_dofs),
+            "status": self.status,
+            "message": self.message,
+            "stats": self.stats,
+        }
+        arrays = {k: getattr(self, k) for k in _ARRAYS}
+        np.savez_compressed(path, meta=np.array(json.dumps(meta)), **arrays)
+        return path if path.suffix == ".npz" else path.with_suffix(path.suffix + ".npz")
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write a CSV: t, then per rigid body position (m), 3-2-1 Euler angles (rad), ω and
+        v (body frame); per point mass r_N and v_N; per slack value and rate."""
+        cols: list[FloatArray] = [self.t[:, None]]
+        header = ["t_s"]
+        for name, kind in zip(self.body_names, self.body_kinds, strict=True):
+            view = self.body(name)
+            if kind == "rigid":
+                cols += [view.position, view.euler("321"), view.omega, view.v]
+                header += [
+                    f"{name}.{q}"
+                    for q in (
+                        "x_m",
+                        "y_m",
+                        "z_m",
+                        "psi_rad",
+                        "theta_rad",
+                        "phi_rad",
+                        "wx_rad_s",
+                        "wy_rad_s",
+                        "wz_rad_s",
+                        "vx_m_s",
+                        "vy_m_s",
+                        "vz_m_s",
+                    )
+                ]
+            elif kind == "point":
+                cols += [view.position, view.velocity]
+                header += [
+                    f"{name}.{q}" for q in ("x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s")
+                ]
+            else:
+                cols += [view.position, view.velocity]
+                header += [f"{name}.s", f"{name}.s_dot"]
+        path = Path(path)
+        np.savetxt(path, np.hstack(cols), delimiter=",", header=",".join(header), comments="")
+        return path
+
+
+@dataclass(frozen=True, eq=False)
+class BodyTrajectory:
+    """Time histories of one body of a :class:`Trajectory`."""
+
+    traj: Trajectory
+    name: str
+
+    def _slot(self) -> Any:
+        return self.traj.layout.slot(self.name)
+
+    def _dof_slice(self, arr: FloatArray) -> FloatArray:
+        s = self._slot()
+        return arr[:, s.offset : s.offset + s.dof]
+
+    @property
+    def position(self) -> FloatArray:
+        """Position r_N (N, 3) (m); the value (N, 1) of a slack coordinate."""
+        s = self._slot()
+        if s.kind == "rigid":
+            return self.traj.g_NB[:, s.index, :3, 3]
+        return self.traj.x[:, s.index : s.index + s.dof]
+
+    @property
+    def velocity(self) -> FloatArray:
+        """Inertial velocity v_N (N, 3) (m/s); the rate (N, 1) of a slack coordinate."""
+        s = self._slot()
+        if s.kind == "rigid":
+            return np.einsum("nij,nj->ni", self.R, self.v)
+        return self.traj.xdot[:, s.index : s.index + s.dof]
+
+    @property
+    def R(self) -> FloatArray:
+        """Attitude R_NB (N, 3, 3) of a rigid body."""
+        return self.traj.g_NB[:, self._rigid(), :3, :3]
+
+    def euler(self, seq: str = "321") -> FloatArray:
+        """Euler angles (N, 3) (rad) of R_NB, see :mod:`gmuk.lie.euler`."""
+        return euler.from_matrix(self.R, seq)  # type: ignore[arg-type]
+
+    def rotation_vector(self) -> FloatArray:
+        """log(R_NB) (N, 3) (rad)."""
+        return so3.log(self.R)
+
+    @property
+    def omega(self) -> FloatArray:
+        """Body angular velocity ω (N, 3) (rad/s), body frame."""
+        return self.traj.V_B[:, self._rigid(), :3]
+
+    @property
+    def v(self) -> FloatArray:
+        """Body-frame translational velocity v (N, 3) (m/s)."""
+        return self.traj.V_B[:, self._rigid(), 3:]
+
+    @property
+    def acceleration(self) -> FloatArray:
+        """Total acceleration (N, dof): [ω̇; v̇] (body frame) or a_N."""
+        return self._dof_slice(self.traj.acceleration)
+
+    @property
+    def constraint_force(self) -> FloatArray:
+        """Constraint wrench [L; f] (N, 6) in the body frame (N·m, N), or force (N, 3)."""
+        return self._dof_slice(self.traj.constraint_force)
+
+    @property
+    def control_force(self) -> FloatArray:
+        """Controller wrench (N, dof)."""
+        return self._dof_slice(self.traj.control_force)
+
+    @property
+    def constraint_acceleration(self) -> FloatArray:
+        """Constraint acceleration ν̇_c (N, dof): [J⁻¹L_c; f_c/m] for a rigid body
+        (rad/s², m/s², body frame), or a_c (N, 3) of a point mass."""
+        return self._dof_slice(self.traj.constraint_acceleration)
+
+    def _rigid(self) -> int:
+        s = self._slot()
+        if s.kind != "rigid":
+            raise DefinitionError(f"{self.name!r} is a {s.kind} body, not a rigid body")
+        return int(s.index)
+
+
+def load_trajectory(path: str | Path) -> Trajectory:
+    """Load a trajectory saved by :meth:`Trajectory.save`.
+
+    Raises
+    ------
+    FileFormatError
+        If the file is not a gmuk trajectory or is missing arrays.
+    """
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            arrays = {k: data[k] for k in _ARRAYS}
+    except KeyError as exc:
+        raise FileFormatError(f"{path}: not a gmuk trajectory (missing {exc})") from None
+    except (OSError, ValueError) as exc:
+        raise FileFormatError(f"{path}: cannot read as a gmuk trajectory .npz: {exc}") from None
+    if meta.get("format_version") != _FORMAT_VERSION:
+        raise FileFormatError(
+            f"{path}: trajectory format version {meta.get('format_version')}"
+            f" is not supported (expected {_FORMAT_VERSION})"
+        )
+    names = {f.name for f in fields(Trajectory)}
+    kw = {k: v for k, v in meta.items() if k in names}
+    return Trajectory(
+        **arrays,
+        **{
+            **kw,
+            "body_names": tuple(meta["body_names"]),
+            "body_kinds": tuple(meta["body_kinds"]),
+            "body_dofs": tuple(meta["body_dofs"]),
+        },
+    )
