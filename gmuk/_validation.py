@@ -11,6 +11,8 @@ from gmuk.errors import NonFiniteError, NotOnGroupError, ShapeError
 
 FloatArray = NDArray[np.float64]
 
+_LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+
 #: Tolerance for RᵀR = I and for the homogeneous row of SE(3) elements.
 GROUP_TOL = 1e-9
 
@@ -66,23 +68,23 @@ def check_rotation(R: Any, name: str = "R", tol: float = GROUP_TOL) -> FloatArra
     A rotation matrix satisfies ``‖RᵀR − I‖_max ≤ tol`` and ``det R = +1`` (to ``tol``).
     Leading batch axes are allowed; the message reports the worst element.
     """
+    from gmuk.lie._kernels import rotation_errors
+
     R = as_array(R, (3, 3), name)
-    err = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1))
-    det = np.linalg.det(R)
-    bad = (err > tol) | (np.abs(det - 1.0) > tol)
-    if np.any(bad):
-        i = (
-            np.unravel_index(
-                int(np.argmax(np.where(bad, err + np.abs(det - 1.0), -1.0))), bad.shape
-            )
-            if bad.ndim
-            else ()
+    flat = np.ascontiguousarray(R.reshape(-1, 3, 3))
+    if flat.shape[0] == 0:
+        return R
+    err, det_err, k = rotation_errors(flat)
+    if err > tol or det_err > tol:
+        where = (
+            f" at index {tuple(int(j) for j in np.unravel_index(k, R.shape[:-2]))}"
+            if R.ndim > 2
+            else ""
         )
-        where = f" at index {tuple(int(j) for j in i)}" if bad.ndim else ""
+        det = float(np.linalg.det(flat[k]))
         raise NotOnGroupError(
             f"{name} must be a rotation matrix (RᵀR = I to {tol:g}, det +1){where}; "
-            f"got max|RᵀR − I| = {float(np.asarray(err)[i]):.3g}, "
-            f"det = {float(np.asarray(det)[i]):.6g}"
+            f"got max|RᵀR − I| = {err:.3g}, det = {det:.6g}"
         )
     return R
 
@@ -94,7 +96,7 @@ def check_se3(g: Any, name: str = "g", tol: float = GROUP_TOL) -> FloatArray:
     ``[0, 0, 0, 1]`` to ``tol``.
     """
     g = as_array(g, (4, 4), name)
-    row_err = np.abs(g[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max()
+    row_err = float(np.abs(g[..., 3, :] - _LAST_ROW).max(initial=0.0))
     if row_err > tol:
         raise NotOnGroupError(
             f"{name} must be a homogeneous transform with last row [0, 0, 0, 1]; "

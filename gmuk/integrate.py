@@ -38,7 +38,7 @@ import numpy as np
 
 from gmuk._validation import FloatArray
 from gmuk.errors import DefinitionError, GmukError, GmukWarning, SimulationError
-from gmuk.lie import se3
+from gmuk.lie import _kernels
 from gmuk.state import State
 from gmuk.trajectory import Trajectory
 
@@ -120,7 +120,7 @@ class _Problem:
 
     def state(self, t: float, Y: FloatArray, G0: FloatArray) -> State:
         xi = Y[self.s_xi].reshape(-1, 6)
-        g = G0 @ se3._exp(xi) if self.nr else G0
+        g = _kernels.compose_exp(G0, xi) if self.nr else G0
         return State(
             t,
             g,
@@ -136,10 +136,7 @@ class _Problem:
         xi = Y[self.s_xi].reshape(-1, 6)
         V = Y[self.s_V].reshape(-1, 6)
         if self.nr:
-            if np.any(xi):
-                dY[self.s_xi] = np.einsum("nij,nj->ni", se3._dexp_inv(xi), V).ravel()
-            else:
-                dY[self.s_xi] = V.ravel()
+            dY[self.s_xi] = _kernels.dexp_inv_apply(xi, V).ravel() if xi.any() else V.ravel()
             dY[self.s_V] = acc.total[self.rigid_idx].ravel()
         e = self.layout.euclid_offsets
         dY[self.s_x] = Y[self.s_xd]
@@ -172,7 +169,7 @@ class _Problem:
         """G₁ = G₀ exp(ξ₁), re-orthonormalised; returns (G₁, Y with ξ reset to 0)."""
         if not self.nr:
             return G0, Y
-        G1 = G0 @ se3._exp(Y[self.s_xi].reshape(-1, 6))
+        G1 = _kernels.compose_exp(G0, Y[self.s_xi].reshape(-1, 6))
         R = G1[:, :3, :3]
         G1[:, :3, :3] = 0.5 * R @ (3.0 * np.eye(3) - np.swapaxes(R, -1, -2) @ R)
         Y = Y.copy()
@@ -500,9 +497,8 @@ class _Stepper:
             t_target = t_end
             if step_to_outputs and outs is not None and out_i < outs.size:
                 t_target = min(t_end, outs[out_i])
-            h_try = min(h, t_target - t)
-            if t + h_try >= t_target - 4 * np.finfo(float).eps * abs(t_target):
-                h_try = t_target - t
+            # Land exactly on the target when within a hair of it (no sliver steps).
+            h_try = t_target - t if t_target - t <= h * (1.0 + 1e-6) else h
             if h_try <= 10 * np.finfo(float).eps * max(1.0, abs(t)):
                 raise _StepFailure(f"step size underflow (h = {h_try:.3g} s)")
             K = self._stages(t, Y, G0, h_try, f0)

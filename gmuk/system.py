@@ -13,6 +13,7 @@ McCann (2020), Eqs. (2)–(3) (point masses), (63)–(64) (rigid bodies on R⁶)
 
 from __future__ import annotations
 
+import itertools
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -22,7 +23,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from gmuk import uk
+from gmuk import _uk_kernels, uk
 from gmuk._validation import FloatArray, as_array, check_se3
 from gmuk.bodies import Body, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
@@ -46,6 +47,7 @@ __all__ = ["Accelerations", "System"]
 
 #: Above this many degrees of freedom (or constraint rows), "auto" selects the sparse path.
 SPARSE_THRESHOLD = 300
+_EPS = float(np.finfo(float).eps)
 
 
 @dataclass(frozen=True, eq=False)
@@ -269,7 +271,7 @@ class System:
         self._ctrl_bodies = [[self._resolve(r) for r in c.bodies] for c in self.controllers]
         offs = np.cumsum([0] + [c.n_states for c in self.controllers])
         self._ctrl_slices = [
-            slice(int(a), int(b)) for a, b in zip(offs[:-1], offs[1:], strict=True)
+            slice(int(a), int(b)) for a, b in itertools.pairwise(offs)
         ]
 
     def _resolve(self, ref: Body | str) -> Body:
@@ -390,17 +392,17 @@ class System:
             out[e] = a[e] * self._m_euclid
         return out
 
-    def _gyroscopic(self, state: State) -> FloatArray:
-        """ad*_V 𝕀 V for every rigid body, as a generalized force (zeros elsewhere)."""
-        Q = np.zeros(self.layout.n_dof)
+    def _free(self, state: State, Q: FloatArray) -> FloatArray:
+        """ν̇_a = M⁻¹(ad*_V 𝕀V + Q) (Eq. 10b for rigid bodies, Q/m for the others)."""
+        a = np.empty(self.layout.n_dof)
         if self.layout.n_rigid:
-            w, v = state.V[:, :3], state.V[:, 3:]
-            Jw = np.einsum("nij,nj->ni", self._J, w)
-            bias = np.empty((self.layout.n_rigid, 6))
-            bias[:, :3] = _cross(Jw, w)
-            bias[:, 3:] = self._m_rigid[:, None] * _cross(v, w)
-            Q[self._rigid_idx] = bias
-        return Q
+            a[self._rigid_idx] = _uk_kernels.rigid_free_accel(
+                state.V, self._J, self._Jinv, self._m_rigid, Q[self._rigid_idx]
+            )
+        if self.layout.n_euclid:
+            e = self.layout.euclid_offsets
+            a[e] = Q[e] / self._m_euclid
+        return a
 
     def _generalized_forces(
         self, state: State
@@ -482,7 +484,7 @@ class System:
         if state.layout is not self.layout and state.layout != self.layout:
             raise DefinitionError("state belongs to another System (layouts differ)")
         modeled, unmodeled, control, z_dot = self._generalized_forces(state)
-        a = self._apply_Minv(self._gyroscopic(state) + modeled)
+        a = self._free(state, modeled)
         extra = self._apply_Minv(unmodeled + control)
         unreachable = 0.0
         if self.tangent_bundle:
@@ -511,14 +513,17 @@ class System:
         A, b = self.constraint_rows(state)
         if b.size == 0:
             return np.zeros_like(a), np.zeros(0), 0, 0.0
-        Aa = A @ a
-        r = b - Aa
         if self.sparse:
-            ac, lam, rank = uk.solve_sparse(sp.csr_matrix(A), r, self._Minv_sp, self._Minv_sqrt_sp)
+            Aa = A @ a
+            ac, lam, rank = uk.solve_sparse(
+                sp.csr_matrix(A), b - Aa, self._Minv_sp, self._Minv_sqrt_sp
+            )
+            residual = float(np.linalg.norm(A @ (a + ac) - b))
+            norm_Aa = float(np.linalg.norm(Aa))
         else:
-            ac, lam, rank = uk.solve_dense(A, r, self._Minv_sqrt, self.rcond)
-        residual = float(np.linalg.norm(A @ (a + ac) - b))
-        scale = max(1.0, float(np.linalg.norm(b)), float(np.linalg.norm(Aa)))
+            rcond = self.rcond if self.rcond is not None else max(A.shape) * _EPS
+            ac, lam, rank, residual, norm_Aa = _uk_kernels.uk_dense(A, b, a, self._Minv_sqrt, rcond)
+        scale = max(1.0, float(np.linalg.norm(b)), norm_Aa)
         if residual > self.consistency_tol * scale:
             msg = (
                 f"constraints are inconsistent at t = {state.t:.9g} s: ‖A ν̇ − b‖ = "
@@ -564,12 +569,3 @@ class System:
             f"forces={len(self.forces)}, controllers={len(self.controllers)}, "
             f"sparse={self.sparse})"
         )
-
-
-def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
-    """Row-wise cross product of (n, 3) arrays (np.cross is slow for small inputs)."""
-    out = np.empty_like(a)
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out

@@ -18,6 +18,7 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from gmuk import _uk_kernels
 from gmuk._validation import FloatArray
 from gmuk.lie import se3
 
@@ -25,15 +26,20 @@ __all__ = ["matrix_power_spd", "solve_dense", "solve_sparse", "solve_tangent_bun
 
 
 def solve_dense(
-    A: FloatArray, r: FloatArray, Minv_sqrt: FloatArray, rcond: float | None = None
-) -> tuple[FloatArray, FloatArray, int]:
+    A: FloatArray,
+    b: FloatArray,
+    a: FloatArray,
+    Minv_sqrt: FloatArray,
+    rcond: float | None = None,
+) -> tuple[FloatArray, FloatArray, int, float]:
     """Minimum-norm UK solution via the SVD of ``B = A M^{-1/2}``.
 
     Parameters
     ----------
     A : ndarray (s, n)
-    r : ndarray (s,)
-        ``b − A a``.
+    b : ndarray (s,)
+    a : ndarray (n,)
+        Free acceleration ν̇_a.
     Minv_sqrt : ndarray (n, n)
         ``M^{-1/2}`` (symmetric).
     rcond : float, optional
@@ -41,22 +47,21 @@ def solve_dense(
 
     Returns
     -------
-    (ν̇_c (n,), λ (s,), rank)
+    (ν̇_c (n,), λ (s,), rank, residual ‖A(a + ν̇_c) − b‖₂)
     """
     s, n = A.shape
     if s == 0:
-        return np.zeros(n), np.zeros(0), 0
-    B = A @ Minv_sqrt
-    U, sig, Wt = np.linalg.svd(B, full_matrices=False)
+        return np.zeros(n), np.zeros(0), 0, 0.0
     if rcond is None:
-        rcond = max(s, n) * np.finfo(float).eps
-    keep = sig > rcond * (sig[0] if sig.size else 0.0)
-    rank = int(np.count_nonzero(keep))
-    Ur = U[:, :rank]
-    c = (Ur.T @ r) / sig[:rank]
-    y = Wt[:rank].T @ c
-    lam = Ur @ (c / sig[:rank])
-    return Minv_sqrt @ y, lam, rank
+        rcond = max(s, n) * float(np.finfo(float).eps)
+    ac, lam, rank, residual, _ = _uk_kernels.uk_dense(
+        np.ascontiguousarray(A, dtype=float),
+        np.asarray(b, dtype=float),
+        np.asarray(a, dtype=float),
+        np.ascontiguousarray(Minv_sqrt, dtype=float),
+        rcond,
+    )
+    return ac, lam, int(rank), float(residual)
 
 
 def solve_sparse(

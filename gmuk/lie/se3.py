@@ -25,7 +25,7 @@ import numpy as np
 
 from gmuk._validation import FloatArray, as_array, check_se3
 from gmuk.errors import NotOnGroupError
-from gmuk.lie import _coeffs
+from gmuk.lie import _kernels
 from gmuk.lie import so3 as _so3
 
 __all__ = ["Ad", "ad", "ad_star", "dexp", "dexp_inv", "exp", "hat", "inverse", "log", "vee"]
@@ -104,15 +104,8 @@ def vee(X: Any) -> FloatArray:
 
 
 def _exp(xi: FloatArray) -> FloatArray:
-    w, rho = xi[..., :3], xi[..., 3:]
-    theta = np.sqrt(np.einsum("...i,...i->...", w, w))
-    b = _coeffs.one_minus_cos_over_sq(theta)[..., None]
-    c = _coeffs.theta_minus_sin_over_cube(theta)[..., None]
-    wxr = _matvec(_so3._hat(w), rho)
-    # t = (I + B w^× + C (w^×)²) ρ, with (w^×)² ρ = w (w·ρ) − θ² ρ.
-    wdr = np.einsum("...i,...i->...", w, rho)[..., None]
-    t = rho + b * wxr + c * (w * wdr - (theta * theta)[..., None] * rho)
-    return _homogeneous(_so3._exp(w), t)
+    flat = np.ascontiguousarray(xi.reshape(-1, 6))
+    return _kernels.se3_exp(flat).reshape((*xi.shape[:-1], 4, 4))
 
 
 def exp(xi: Any) -> FloatArray:
@@ -133,15 +126,8 @@ def exp(xi: Any) -> FloatArray:
 
 
 def _log(g: FloatArray) -> FloatArray:
-    R, t = g[..., :3, :3], g[..., :3, 3]
-    w = _so3._log(R)
-    theta = np.sqrt(np.einsum("...i,...i->...", w, w))
-    d = _coeffs.dexp_inv_d(theta)[..., None]
-    wxt = _matvec(_so3._hat(w), t)
-    wdt = np.einsum("...i,...i->...", w, t)[..., None]
-    # ρ = Jₗ⁻¹ t = (I − ½ w^× + D (w^×)²) t
-    rho = t - 0.5 * wxt + d * (w * wdt - (theta * theta)[..., None] * t)
-    return np.concatenate([w, rho], axis=-1)
+    flat = np.ascontiguousarray(g.reshape(-1, 4, 4))
+    return _kernels.se3_log(flat).reshape((*g.shape[:-2], 6))
 
 
 def log(g: Any) -> FloatArray:
@@ -237,35 +223,11 @@ def ad_star(V: Any) -> FloatArray:
     return np.swapaxes(ad(V), -1, -2)
 
 
-def _dexp_inv_blocks(xi: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Return (T, P, T², theta) with T = θ^×, P = ρ^× for the block forms."""
-    w = xi[..., :3]
-    T = _so3._hat(w)
-    P = _so3._hat(xi[..., 3:])
-    theta = np.sqrt(np.einsum("...i,...i->...", w, w))
-    return T, P, T @ T, theta
-
-
-def _blocks_to_6x6(X: FloatArray, Y: FloatArray) -> FloatArray:
-    out = np.zeros((*X.shape[:-2], 6, 6))
-    out[..., :3, :3] = X
-    out[..., 3:, 3:] = X
-    out[..., 3:, :3] = Y
-    return out
-
-
 def _dexp_inv(xi: FloatArray) -> FloatArray:
-    T, P, T2, theta = _dexp_inv_blocks(xi)
-    f1, f2 = _coeffs.dexp_inv_f1_f2(theta)
-    d = _coeffs.dexp_inv_d(theta)[..., None, None]
-    f1 = f1[..., None, None]
-    f2 = f2[..., None, None]
     # ad_ξ = [[T, 0], [P, T]]; ad² = [[T², 0], [Y₂, T²]], ad⁴ = [[T⁴, 0], [Y₂T² + T²Y₂, T⁴]],
     # and T⁴ = −θ² T², so the diagonal block I + ½T + (F₁ − θ²F₂) T² = I + ½T + D T².
-    Y2 = P @ T + T @ P
-    X = np.eye(3) + 0.5 * T + d * T2
-    Y = 0.5 * P + f1 * Y2 + f2 * (Y2 @ T2 + T2 @ Y2)
-    return _blocks_to_6x6(X, Y)
+    flat = np.ascontiguousarray(xi.reshape(-1, 6))
+    return _kernels.dexp_inv_matrix(flat).reshape((*xi.shape[:-1], 6, 6))
 
 
 def dexp_inv(xi: Any) -> FloatArray:
@@ -294,14 +256,10 @@ def dexp_inv(xi: Any) -> FloatArray:
 
 
 def _dexp(xi: FloatArray) -> FloatArray:
-    T, _, T2, theta = _dexp_inv_blocks(xi)
     # dexp = [[Jᵣ, 0], [−Jᵣ Y Jᵣ, Jᵣ]] where [[X, 0], [Y, X]] = dexp_inv and Jᵣ = X⁻¹ is the
     # SO(3) right Jacobian I − B T + C T².
-    b = _coeffs.one_minus_cos_over_sq(theta)[..., None, None]
-    c = _coeffs.theta_minus_sin_over_cube(theta)[..., None, None]
-    Jr = np.eye(3) - b * T + c * T2
-    Y = _dexp_inv(xi)[..., 3:, :3]
-    return _blocks_to_6x6(Jr, -Jr @ Y @ Jr)
+    flat = np.ascontiguousarray(xi.reshape(-1, 6))
+    return _kernels.dexp_matrix(flat).reshape((*xi.shape[:-1], 6, 6))
 
 
 def dexp(xi: Any) -> FloatArray:

@@ -19,7 +19,7 @@ import numpy as np
 
 from gmuk._validation import FloatArray, as_array, check_rotation
 from gmuk.errors import NotOnGroupError
-from gmuk.lie import _coeffs
+from gmuk.lie import _kernels
 
 __all__ = ["exp", "hat", "log", "vee"]
 
@@ -88,11 +88,8 @@ def vee(W: Any) -> FloatArray:
 
 
 def _exp(w: FloatArray) -> FloatArray:
-    theta = np.sqrt(np.einsum("...i,...i->...", w, w))
-    a = _coeffs.sinc(theta)[..., None, None]
-    b = _coeffs.one_minus_cos_over_sq(theta)[..., None, None]
-    c = np.cos(theta)[..., None, None]
-    return c * np.eye(3) + a * _hat(w) + b * (w[..., :, None] * w[..., None, :])
+    flat = np.ascontiguousarray(w.reshape(-1, 3))
+    return _kernels.so3_exp(flat).reshape((*w.shape[:-1], 3, 3))
 
 
 def exp(w: Any) -> FloatArray:
@@ -113,24 +110,8 @@ def exp(w: Any) -> FloatArray:
 
 
 def _log(R: FloatArray) -> FloatArray:
-    c = 0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0)
-    s_vec = 0.5 * _vee(R - np.swapaxes(R, -1, -2))  # = sin θ · e
-    s = np.sqrt(np.einsum("...i,...i->...", s_vec, s_vec))
-    theta = np.arctan2(s, np.clip(c, -1.0, 1.0))
-    # Regular branch: w = θ/sin θ · s_vec. θ/s = 1/sinc(θ) is accurate down to θ = 0.
-    w = s_vec / _coeffs.sinc(theta)[..., None]
-    # Near π the antisymmetric part vanishes; take the axis from the symmetric part instead:
-    # (R + Rᵀ)/2 − c I = (1 − c) e eᵀ. Use the column with the largest diagonal entry.
-    near_pi = (c < 0.0) & (s < 0.1)
-    if np.any(near_pi):
-        S = 0.5 * (R + np.swapaxes(R, -1, -2)) - c[..., None, None] * np.eye(3)
-        k = np.argmax(np.diagonal(S, axis1=-2, axis2=-1), axis=-1)
-        col = np.take_along_axis(S, k[..., None, None], axis=-1)[..., 0]
-        skk = np.take_along_axis(np.diagonal(S, axis1=-2, axis2=-1), k[..., None], axis=-1)
-        e = col / np.sqrt(skk * (1.0 - c[..., None]))
-        sign = np.where(np.einsum("...i,...i->...", e, s_vec) < 0.0, -1.0, 1.0)
-        w = np.where(near_pi[..., None], (sign * theta)[..., None] * e, w)
-    return w
+    flat = np.ascontiguousarray(R.reshape(-1, 3, 3))
+    return _kernels.so3_log(flat).reshape(R.shape[:-1])
 
 
 def log(R: Any) -> FloatArray:
