@@ -335,7 +335,7 @@ def simulate(
     except KeyboardInterrupt:
         status, message = "interrupted", f"interrupted by the user at t = {stepper.t:.9g} s"
         warnings.warn(message + "; returning the trajectory so far", GmukWarning, stacklevel=2)
-    except (GmukError, FloatingPointError, np.linalg.LinAlgError, _StepFailure) as exc:
+    except Exception as exc:
         status = "failed"
         message = f"failed at t = {stepper.t:.9g} s: {type(exc).__name__}: {exc}"
         if on_failure == "raise":

@@ -270,9 +270,7 @@ class System:
             self._force_bodies.append(bs)
         self._ctrl_bodies = [[self._resolve(r) for r in c.bodies] for c in self.controllers]
         offs = np.cumsum([0] + [c.n_states for c in self.controllers])
-        self._ctrl_slices = [
-            slice(int(a), int(b)) for a, b in itertools.pairwise(offs)
-        ]
+        self._ctrl_slices = [slice(int(a), int(b)) for a, b in itertools.pairwise(offs)]
 
     def _resolve(self, ref: Body | str) -> Body:
         return self._by_name[ref if isinstance(ref, str) else ref.name]

@@ -23,6 +23,10 @@ Steps: rotations 1e-3 rad, translations 1e-3·``fd_length`` m, and along the pat
 no coordinate moves more than 2e-3 (in rad, or in units of ``fd_length``) and
 τ ≤ 2e-3·``fd_time``. Set ``fd_length`` (m) and ``fd_time`` (s) to the scales on which the
 residual varies; agreement with analytic rows is typically 1e-9 relative (tested ≤ 1e-7).
+The rows then carry round-off noise of about eps/τ² ≈ 1e-10 of the residual's scale: integrate
+with ``rtol`` ≳ 1e-10 (tighter tolerances make the step controller chase the noise), and
+expect an unstabilised constraint to drift like ½·1e-10·t² (use :class:`Baumgarte`, or
+override :meth:`jacobian` and :meth:`bias` with exact forms, for long or very tight runs).
 """
 
 from __future__ import annotations

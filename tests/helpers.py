@@ -1,0 +1,62 @@
+"""Shared builders for the engine tests (not a test module)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import gmuk
+from gmuk.lie import se3
+from gmuk.reference import ReferenceState, ReferenceTrajectory
+
+
+class Rows(gmuk.Constraint):
+    """The lowest-level user constraint of the issue's API: fixed rows."""
+
+    def __init__(self, bodies, A, b):
+        super().__init__(bodies)
+        self.A, self.b = A, b
+
+    def rows(self, state):
+        return self.A, self.b
+
+
+class ScrewReference(ReferenceTrajectory):
+    """g_d(t) = g0 exp(t ξ): constant body twist V_d = ξ, V̇_d = 0 (closed form)."""
+
+    def __init__(self, g0, xi):
+        self.g0, self.xi = np.asarray(g0, float), np.asarray(xi, float)
+
+    def evaluate(self, t):
+        return ReferenceState(self.g0 @ se3.exp(t * self.xi), self.xi.copy(), np.zeros(6))
+
+
+def random_inertia(rng):
+    """A random physical central inertia tensor (kg·m²) in a random orientation."""
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    moments = rng.uniform(1.0, 2.0, 3)
+    return Q @ np.diag(moments) @ Q.T
+
+
+def random_rigid_bodies(rng, n, prefix="b"):
+    return [
+        gmuk.RigidBody(f"{prefix}{i}", rng.uniform(1.0, 5.0), random_inertia(rng)) for i in range(n)
+    ]
+
+
+def random_state(system, rng, scale=1.0):
+    names = [b.name for b in system.bodies if b.kind == "rigid"]
+    points = [b.name for b in system.bodies if b.kind == "point"]
+    return system.state(
+        g={n: se3.exp(rng.normal(size=6) * scale) for n in names},
+        V={n: rng.normal(size=6) for n in names},
+        r={n: rng.normal(size=3) for n in points},
+        v={n: rng.normal(size=3) for n in points},
+    )
+
+
+def kkt_solve(M, a, A, b):
+    """Solve [M Aᵀ; A 0][ν̇; μ] = [M a; b] (full row rank A)."""
+    n, s = M.shape[0], A.shape[0]
+    K = np.block([[M, A.T], [A, np.zeros((s, s))]])
+    sol = np.linalg.solve(K, np.concatenate([M @ a, b]))
+    return sol[:n], sol[n:]
