@@ -59,3 +59,30 @@ def uk_dense(
     ac = Minv_sqrt @ y
     res = A @ (a + ac) - b
     return ac, lam, rank, np.sqrt(np.sum(res * res)), np.sqrt(np.sum(Aa * Aa))
+
+
+@njit(cache=True)
+def tracking_b(
+    g: np.ndarray, V: np.ndarray, gd: np.ndarray, Vd: np.ndarray, Vd_dot: np.ndarray
+) -> np.ndarray:
+    """b of Eq. 67, projected: se(3) part of g⁻¹ g_d (V_d^² + V̇_d^) − V^² as a twist."""
+    H = np.zeros((4, 4))
+    Hd = np.zeros((4, 4))
+    Hdd = np.zeros((4, 4))
+    for M, x in ((H, V), (Hd, Vd), (Hdd, Vd_dot)):
+        M[0, 1], M[0, 2], M[1, 2] = -x[2], x[1], -x[0]
+        M[1, 0], M[2, 0], M[2, 1] = x[2], -x[1], x[0]
+        M[0, 3], M[1, 3], M[2, 3] = x[3], x[4], x[5]
+    ginv = np.zeros((4, 4))
+    for i in range(3):
+        for j in range(3):
+            ginv[i, j] = g[j, i]
+        ginv[i, 3] = -(g[0, i] * g[0, 3] + g[1, i] * g[1, 3] + g[2, i] * g[2, 3])
+    ginv[3, 3] = 1.0
+    X = ginv @ gd @ (Hd @ Hd + Hdd) - H @ H
+    out = np.empty(6)
+    out[0] = 0.5 * (X[2, 1] - X[1, 2])
+    out[1] = 0.5 * (X[0, 2] - X[2, 0])
+    out[2] = 0.5 * (X[1, 0] - X[0, 1])
+    out[3], out[4], out[5] = X[0, 3], X[1, 3], X[2, 3]
+    return out

@@ -162,10 +162,10 @@ class System:
             n_ctrl,
         )
         self._by_name = {b.name: b for b in self.bodies}
+        # Rows are unknown until evaluated; the number of dof decides "auto".
+        self.sparse = (self.layout.n_dof > SPARSE_THRESHOLD) if sparse == "auto" else bool(sparse)
         self._build_mass()
         self._build_index()
-        n_rows_hint = self.layout.n_dof  # rows are unknown until evaluated; dof is the proxy
-        self.sparse = (n_rows_hint > SPARSE_THRESHOLD) if sparse == "auto" else bool(sparse)
         self.tangent_bundle = any(isinstance(c, TangentBundleConstraint) for c in self.constraints)
 
     # ------------------------------------------------------------------ validation
@@ -234,33 +234,44 @@ class System:
     # ------------------------------------------------------------------ set-up
     def _build_mass(self) -> None:
         blocks = [b.mass_matrix() for b in self.bodies]
-        self.mass_matrix = scipy.linalg.block_diag(*blocks)
+        self._M_blocks = blocks
         rigid = [b for b in self.bodies if isinstance(b, RigidBody)]
         self._J = np.array([b.inertia for b in rigid]).reshape(-1, 3, 3)
         self._Jinv = np.linalg.inv(self._J) if rigid else self._J.copy()
         self._m_rigid = np.array([b.mass for b in rigid])
         euclid = [b for b in self.bodies if b.kind != "rigid"]
         self._m_euclid = (
-            np.concatenate([np.full(b.dof, b.mass) for b in euclid]) if euclid else np.zeros(0)
-        )  # type: ignore[attr-defined]
+            np.concatenate([np.full(b.dof, b.mass) for b in euclid])  # type: ignore[attr-defined]
+            if euclid
+            else np.zeros(0)
+        )
+        inv = [np.linalg.inv(B) for B in blocks]
         inv_sqrt = [uk.matrix_power_spd(B, -0.5) for B in blocks]
-        self._Minv_sqrt = scipy.linalg.block_diag(*inv_sqrt)
-        self._Minv_sp = sp.csr_matrix(scipy.linalg.block_diag(*[np.linalg.inv(B) for B in blocks]))
-        self._Minv_sqrt_sp = sp.csr_matrix(self._Minv_sqrt)
-        if rigid:  # 𝕀̃^{-1/4} for the T²SE(3) solve: blkdiag(J^{-1/4}, m^{-1/4}) per body
-            self._I_tilde_m14 = scipy.linalg.block_diag(
-                *[
-                    scipy.linalg.block_diag(
-                        uk.matrix_power_spd(b.inertia, -0.25), [[b.mass**-0.25]]
-                    )
-                    for b in rigid
-                ]
-            )
+        if self.sparse:  # never form n_dof × n_dof dense matrices on the sparse path
+            self._Minv_sp = sp.block_diag(inv, format="csr")
+            self._Minv_sqrt_sp = sp.block_diag(inv_sqrt, format="csr")
+        else:
+            self._M_dense = scipy.linalg.block_diag(*blocks)
+            self._Minv_dense = scipy.linalg.block_diag(*inv)
+            self._Minv_sqrt = scipy.linalg.block_diag(*inv_sqrt)
+        if rigid:  # 𝕀̃^{-1/4} blocks for the T²SE(3) solve: blkdiag(J^{-1/4}, m^{-1/4})
+            self._I_tilde_m14_blocks = [
+                scipy.linalg.block_diag(uk.matrix_power_spd(b.inertia, -0.25), [[b.mass**-0.25]])
+                for b in rigid
+            ]
+
+    @property
+    def mass_matrix(self) -> FloatArray:
+        """The block-diagonal mass matrix M = 𝕀̄ (n_dof, n_dof), dense (SI units)."""
+        if self.sparse:
+            return scipy.linalg.block_diag(*self._M_blocks)  # type: ignore[no-any-return]
+        return self._M_dense  # type: ignore[no-any-return]
 
     def _build_index(self) -> None:
         lay = self.layout
         self._rigid_idx = (lay.rigid_offsets[:, None] + np.arange(6)).reshape(-1, 6)
         self._constraint_cols = [lay.columns(c.bodies) for c in self.constraints]
+        self._all_cols = np.arange(lay.n_dof)
         self._force_bodies: list[list[Body]] = []
         for f in self.forces:
             if f.bodies is None:
@@ -365,6 +376,8 @@ class System:
 
     # ------------------------------------------------------------------ dynamics
     def _apply_Minv(self, Q: FloatArray) -> FloatArray:
+        if not self.sparse:
+            return self._Minv_dense @ Q  # type: ignore[no-any-return]
         out = np.empty_like(Q)
         if self.layout.n_rigid:
             Qr = Q[self._rigid_idx]
@@ -378,6 +391,8 @@ class System:
         return out
 
     def _apply_M(self, a: FloatArray) -> FloatArray:
+        if not self.sparse:
+            return self._M_dense @ a  # type: ignore[no-any-return]
         out = np.empty_like(a)
         if self.layout.n_rigid:
             ar = a[self._rigid_idx]
@@ -441,24 +456,32 @@ class System:
         s = sum(bi.size for _, bi, _ in blocks)
         b = np.concatenate([bi for _, bi, _ in blocks]) if blocks else np.zeros(0)
         if self.sparse:
+            if not blocks:
+                return sp.csr_matrix((0, n)), b
             rows, cols_all, data = [], [], []
             r0 = 0
             for Ai, bi, cols in blocks:
-                rr, cc = np.meshgrid(np.arange(r0, r0 + bi.size), cols, indexing="ij")
-                rows.append(rr.ravel())
-                cols_all.append(cc.ravel())
-                data.append(Ai.ravel())
+                coo = sp.coo_matrix(Ai)
+                rows.append(coo.row + r0)
+                cols_all.append(cols[coo.col])
+                data.append(coo.data)
                 r0 += bi.size
-            if not blocks:
-                return sp.csr_matrix((0, n)), b
-            return sp.csr_matrix(
+            A_sp = sp.csr_matrix(
                 (np.concatenate(data), (np.concatenate(rows), np.concatenate(cols_all))),
                 shape=(s, n),
-            ), b
+            )
+            return A_sp, b
+        if (
+            len(blocks) == 1
+            and self._constraint_cols[0].size == n
+            and not sp.issparse(blocks[0][0])
+            and np.array_equal(self._constraint_cols[0], self._all_cols)
+        ):
+            return np.ascontiguousarray(blocks[0][0]), b
         A = np.zeros((s, n))
         r0 = 0
         for Ai, bi, cols in blocks:
-            A[r0 : r0 + bi.size, cols] = Ai
+            A[r0 : r0 + bi.size, cols] = Ai.toarray() if sp.issparse(Ai) else Ai
             r0 += bi.size
         return A, b
 
@@ -521,7 +544,7 @@ class System:
         else:
             rcond = self.rcond if self.rcond is not None else max(A.shape) * _EPS
             ac, lam, rank, residual, norm_Aa = _uk_kernels.uk_dense(A, b, a, self._Minv_sqrt, rcond)
-        scale = max(1.0, float(np.linalg.norm(b)), norm_Aa)
+        scale = max(1.0, float(np.sqrt(b @ b)), norm_Aa)
         if residual > self.consistency_tol * scale:
             msg = (
                 f"constraints are inconsistent at t = {state.t:.9g} s: ‖A ν̇ − b‖ = "
@@ -551,8 +574,9 @@ class System:
         return ac, np.zeros(0), None, residual, unreachable
 
     def _I_tilde_m14_for(self, rigid_indices: list[int]) -> FloatArray:
-        sel = np.concatenate([np.arange(4 * i, 4 * i + 4) for i in rigid_indices])
-        return self._I_tilde_m14[np.ix_(sel, sel)]  # type: ignore[no-any-return]
+        return scipy.linalg.block_diag(  # type: ignore[no-any-return]
+            *[self._I_tilde_m14_blocks[i] for i in rigid_indices]
+        )
 
     # ------------------------------------------------------------------ simulation
     def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:

@@ -130,14 +130,24 @@ class Constraint(abc.ABC):
         return f"{type(self).__name__}(bodies={list(self.body_names)}, name={self.name!r})"
 
 
-def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[FloatArray, FloatArray]:
-    """Check and convert a constraint's (A, b); raise ConstraintError with details."""
+def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[Any, FloatArray]:
+    """Check and convert a constraint's (A, b); raise ConstraintError with details.
+
+    A may be dense (array_like) or a scipy.sparse matrix (kept sparse, as CSR).
+    """
+    import scipy.sparse as sp
+
     from gmuk.errors import ConstraintError
 
-    A = np.asarray(A, dtype=float)
+    if sp.issparse(A):
+        A = sp.csr_matrix(A, dtype=float)
+        finite_A = bool(np.isfinite(A.data).all())
+    else:
+        A = np.asarray(A, dtype=float)
+        if A.ndim == 1:
+            A = A[None, :]
+        finite_A = bool(np.isfinite(A).all())
     b = np.asarray(b, dtype=float)
-    if A.ndim == 1:
-        A = A[None, :]
     if b.ndim == 0:
         b = b[None]
     if A.ndim != 2 or A.shape[1] != n_cols or b.shape != (A.shape[0],):
@@ -145,6 +155,6 @@ def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[FloatArray, FloatArr
             f"{who}: rows() must return A of shape (s, {n_cols}) and b of shape (s,); "
             f"got A {A.shape} and b {b.shape}"
         )
-    if not (np.isfinite(A).all() and np.isfinite(b).all()):
+    if not (finite_A and np.isfinite(b).all()):
         raise ConstraintError(f"{who}: rows() returned NaN or inf in A or b")
     return A, b

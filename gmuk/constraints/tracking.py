@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gmuk import _uk_kernels
 from gmuk._validation import FloatArray
 from gmuk.constraints.base import Baumgarte, Constraint
 from gmuk.errors import DefinitionError
@@ -25,6 +26,9 @@ if TYPE_CHECKING:
     from gmuk.state import State
 
 __all__ = ["ConfigurationTracking", "project_to_se3", "tracking_errors"]
+
+_EYE6 = np.eye(6)
+_EYE6.setflags(write=False)
 
 
 def project_to_se3(X: FloatArray) -> FloatArray:
@@ -93,11 +97,14 @@ class ConfigurationTracking(Constraint):
         (body,) = self.bodies
         g, V = state.pose(body), state.twist(body)
         ref = self.reference.evaluate(state.t)
-        Vd_hat = se3._hat(ref.V)
-        Vh = se3._hat(V)
-        X = se3._inverse(g) @ ref.g @ (Vd_hat @ Vd_hat + se3._hat(ref.V_dot)) - Vh @ Vh
-        b = project_to_se3(X)
+        b = _uk_kernels.tracking_b(
+            g,
+            V,
+            np.asarray(ref.g, dtype=float),
+            np.asarray(ref.V, dtype=float),
+            np.asarray(ref.V_dot, dtype=float),
+        )
         if self.baumgarte is not None:
             e_g, e_V = tracking_errors(g, V, ref.g, ref.V)
             b = b - self.baumgarte.alpha * e_V - self.baumgarte.beta * e_g
-        return np.eye(6), b
+        return _EYE6, b

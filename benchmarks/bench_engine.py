@@ -1,0 +1,172 @@
+"""Per-call cost of System.accelerations beside Pinocchio's constrained forward dynamics.
+
+Run on demand (not a test):
+
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_engine.py [--quick]
+
+Cases (issue #3): one body with a tracking constraint; the virtual-spacecraft pair
+(6 tracking rows + 5 relative rows); n = 10, 100, 1000 free bodies with 5n random sparse
+constraint rows (each row couples two random bodies), on the dense and the sparse path.
+Pinocchio: ``pin.forwardDynamics(model, data, q, v, tau, J, gamma)`` with n free-flyer joints
+(the same KKT problem), timed in the same run; it cannot build n = 1000 here.
+Medians over repeats; prints a Markdown table.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+import gmuk
+from gmuk.lie import se3
+from gmuk.reference import ReferenceState, ReferenceTrajectory
+
+
+class Screw(ReferenceTrajectory):
+    def __init__(self, xi):
+        self.xi = np.asarray(xi, float)
+
+    def evaluate(self, t):
+        return ReferenceState(se3.exp(t * self.xi), self.xi, np.zeros(6))
+
+
+class SparseRows(gmuk.Constraint):
+    def __init__(self, bodies, A, b):
+        super().__init__(bodies)
+        self.A, self.b = A, b
+
+    def rows(self, state):
+        return self.A, self.b
+
+
+def per_call(fn, min_time=0.2, repeat=7):
+    """Median seconds per call over ``repeat`` batches of about ``min_time`` each."""
+    fn()
+    n, t0 = 1, time.perf_counter()
+    fn()
+    dt = time.perf_counter() - t0
+    n = max(1, int(min_time / max(dt, 1e-9)))
+    samples = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        for _ in range(n):
+            fn()
+        samples.append((time.perf_counter() - t0) / n)
+    return statistics.median(samples)
+
+
+def perm6():
+    P = np.zeros((6, 6))
+    P[:3, 3:] = P[3:, :3] = np.eye(3)  # [ω; v] ↔ [v; ω]
+    return P
+
+
+def pin_case(bodies, A, b, V):
+    """Pinocchio forwardDynamics for free-flyers at the identity pose, twists V (n, 6)."""
+    import pinocchio as pin
+
+    model = pin.Model()
+    for i, body in enumerate(bodies):
+        j = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), f"ff{i}")
+        model.appendBodyToJoint(
+            j, pin.Inertia(body.mass, np.zeros(3), body.inertia), pin.SE3.Identity()
+        )
+    data = model.createData()
+    n = len(bodies)
+    P = np.kron(np.eye(n), perm6())
+    q = pin.neutral(model)
+    v = P @ V.ravel()
+    tau = np.zeros(6 * n)
+    J = A @ P  # columns reordered to Pinocchio's [v; ω]
+    gamma = -b  # Pinocchio solves J a = −γ
+    return per_call(lambda: pin.forwardDynamics(model, data, q, v, tau, J, gamma))
+
+
+def random_rows(rng, n, s):
+    rows, cols, vals = [], [], []
+    for r in range(s):
+        i, j = rng.choice(n, 2, replace=False)
+        idx = np.concatenate([np.arange(6 * i, 6 * i + 6), np.arange(6 * j, 6 * j + 6)])
+        rows.extend([r] * 12)
+        cols.extend(idx)
+        vals.extend(rng.normal(size=12))
+    return sp.csr_matrix((vals, (rows, cols)), shape=(s, 6 * n)), rng.normal(size=s)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true", help="skip n = 1000")
+    args = ap.parse_args()
+    rng = np.random.default_rng(0)
+    J = np.diag([3.0e4, 3.2e4, 3.4e4])
+    out = []
+
+    body = gmuk.RigidBody("a", 15103.0, J)
+    ref = Screw([0, 0, 1e-3, 1600.0, 0, 0])
+    sys1 = gmuk.System([body], [gmuk.ConfigurationTracking(body, ref)])
+    st1 = sys1.state(g={"a": np.eye(4)}, V={"a": ref.xi})
+    A1, b1 = sys1.constraint_rows(st1)
+    out.append(
+        (
+            "1 body, tracking (6 rows)",
+            per_call(lambda: sys1.accelerations(st1)),
+            pin_case([body], A1, b1, st1.V),
+        )
+    )
+
+    L, B = gmuk.RigidBody("virtual", 15103.0, J), gmuk.RigidBody("spacecraft", 15103.0, J)
+    sys2 = gmuk.System(
+        [L, B], [gmuk.ConfigurationTracking(L, ref), gmuk.RelativeConstraint(B, L, free_axes=[0])]
+    )
+    st2 = sys2.state(
+        g={"virtual": np.eye(4), "spacecraft": np.eye(4)},
+        V={"virtual": ref.xi, "spacecraft": ref.xi},
+    )
+    A2, b2 = sys2.constraint_rows(st2)
+    out.append(
+        (
+            "virtual pair (11 rows)",
+            per_call(lambda: sys2.accelerations(st2)),
+            pin_case([L, B], A2, b2, st2.V),
+        )
+    )
+
+    for n in [10, 100] if args.quick else [10, 100, 1000]:
+        bodies = [
+            gmuk.RigidBody(f"b{i}", rng.uniform(1, 5), np.diag(rng.uniform(1, 2, 3)))
+            for i in range(n)
+        ]
+        A, b = random_rows(rng, n, 5 * n)
+        names = [bd.name for bd in bodies]
+        for path in (False, True):
+            if n == 1000 and not path:
+                continue
+            system = gmuk.System(bodies, [SparseRows(bodies, A, b)], sparse=path)
+            st = system.state(
+                g={k: np.eye(4) for k in names}, V={k: rng.normal(size=6) for k in names}
+            )
+            t_gmuk = per_call(lambda: system.accelerations(st), repeat=5)  # noqa: B023
+            t_pin = pin_case(bodies, A.toarray(), b, st.V) if (n <= 100 and path) else None
+            out.append(
+                (f"{n} bodies, {5 * n} rows, {'sparse' if path else 'dense'}", t_gmuk, t_pin)
+            )
+
+    print("| case | gmuk (µs) | Pinocchio (µs) | gmuk / Pinocchio |")
+    print("|---|---:|---:|---:|")
+    for name, tg, tp in out:
+        ratio = f"{tg / tp:.2f}" if tp else "—"
+        tp_s = f"{tp * 1e6:.1f}" if tp else "—"
+        print(f"| {name} | {tg * 1e6:.1f} | {tp_s} | {ratio} |")
+
+
+if __name__ == "__main__":
+    main()
