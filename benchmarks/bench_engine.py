@@ -5,8 +5,9 @@ Run on demand (not a test):
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_engine.py [--quick]
 
 Cases (issue #3): one body with a tracking constraint; the virtual-spacecraft pair
-(6 tracking rows + 5 relative rows); n = 10, 100, 1000 free bodies with 5n random sparse
-constraint rows (each row couples two random bodies), on the dense and the sparse path.
+(6 tracking rows + 5 relative rows); n = 10, 100, 1000 free bodies with 5n sparse constraint
+rows, each coupling two bodies: along a chain (the typical multibody structure) or between
+random pairs (a random graph, the worst case for sparse LU, also solved by CG).
 Pinocchio: ``pin.forwardDynamics(model, data, q, v, tau, J, gamma)`` with n free-flyer joints
 (the same KKT problem), timed in the same run; it cannot build n = 1000 here.
 Medians over repeats; prints a Markdown table.
@@ -91,10 +92,20 @@ def pin_case(bodies, A, b, V):
     return per_call(lambda: pin.forwardDynamics(model, data, q, v, tau, J, gamma))
 
 
+def chain_rows(rng, n, s):
+    """Row r couples body r // 5 with the next one (a chain, as in linked multibody systems)."""
+    return _rows(rng, n, s, lambda r: (min(r // 5, n - 2), min(r // 5, n - 2) + 1))
+
+
 def random_rows(rng, n, s):
+    """Row r couples two random bodies (a random graph: the worst case for sparse LU)."""
+    return _rows(rng, n, s, lambda r: tuple(rng.choice(n, 2, replace=False)))
+
+
+def _rows(rng, n, s, pair):
     rows, cols, vals = [], [], []
     for r in range(s):
-        i, j = rng.choice(n, 2, replace=False)
+        i, j = pair(r)
         idx = np.concatenate([np.arange(6 * i, 6 * i + 6), np.arange(6 * j, 6 * j + 6)])
         rows.extend([r] * 12)
         cols.extend(idx)
@@ -140,25 +151,30 @@ def main() -> None:
         )
     )
 
-    for n in [10, 100] if args.quick else [10, 100, 1000]:
+    cases = [
+        (10, "chain", False),
+        (10, "chain", True),
+        (100, "chain", False),
+        (100, "chain", True),
+        (100, "random", True),
+        (100, "random", True, "cg"),
+    ]
+    if not args.quick:
+        cases += [(1000, "chain", True), (1000, "random", True, "cg")]
+    for n, kind, path, *solver in cases:
         bodies = [
             gmuk.RigidBody(f"b{i}", rng.uniform(1, 5), np.diag(rng.uniform(1, 2, 3)))
             for i in range(n)
         ]
-        A, b = random_rows(rng, n, 5 * n)
+        A, b = (chain_rows if kind == "chain" else random_rows)(rng, n, 5 * n)
         names = [bd.name for bd in bodies]
-        for path in (False, True):
-            if n == 1000 and not path:
-                continue
-            system = gmuk.System(bodies, [SparseRows(bodies, A, b)], sparse=path)
-            st = system.state(
-                g={k: np.eye(4) for k in names}, V={k: rng.normal(size=6) for k in names}
-            )
-            t_gmuk = per_call(lambda: system.accelerations(st), repeat=5)  # noqa: B023
-            t_pin = pin_case(bodies, A.toarray(), b, st.V) if (n <= 100 and path) else None
-            out.append(
-                (f"{n} bodies, {5 * n} rows, {'sparse' if path else 'dense'}", t_gmuk, t_pin)
-            )
+        how = solver[0] if solver else "lu"
+        system = gmuk.System(bodies, [SparseRows(bodies, A, b)], sparse=path, sparse_solver=how)
+        st = system.state(g={k: np.eye(4) for k in names}, V={k: rng.normal(size=6) for k in names})
+        t_gmuk = per_call(lambda: system.accelerations(st), repeat=5)  # noqa: B023
+        t_pin = pin_case(bodies, A.toarray(), b, st.V) if (n <= 100 and path) else None
+        label = f"{n} bodies, {5 * n} rows, {kind}, {'sparse ' + how if path else 'dense'}"
+        out.append((label, t_gmuk, t_pin))
 
     print("| case | gmuk (µs) | Pinocchio (µs) | gmuk / Pinocchio |")
     print("|---|---:|---:|---:|")

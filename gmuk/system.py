@@ -113,7 +113,11 @@ class System:
     forces : sequence of ForceModel
     controllers : sequence of Controller
     sparse : {"auto", True, False}
-        Solve path: "auto" uses sparse linear algebra above ``SPARSE_THRESHOLD`` dof or rows.
+        Solve path: "auto" uses sparse linear algebra above ``SPARSE_THRESHOLD`` dof.
+    sparse_solver : {"lu", "cg"}
+        Sparse solve of A M⁻¹ Aᵀ λ = r: direct LU (exact; best for chain- or mesh-like
+        coupling) or conjugate gradients (best for large, randomly coupled systems); see
+        :func:`gmuk.uk.solve_sparse`.
     strict : bool
         Raise :class:`gmuk.errors.InconsistentConstraintsError` on inconsistent constraints
         instead of warning.
@@ -136,6 +140,7 @@ class System:
         controllers: Sequence[Controller] = (),
         *,
         sparse: bool | str = "auto",
+        sparse_solver: str = "lu",
         strict: bool = False,
         consistency_tol: float = 1e-8,
         rcond: float | None = None,
@@ -149,6 +154,9 @@ class System:
             raise DefinitionError(problems)
         if sparse not in ("auto", True, False):
             raise DefinitionError(f"sparse must be 'auto', True or False; got {sparse!r}")
+        if sparse_solver not in ("lu", "cg"):
+            raise DefinitionError(f"sparse_solver must be 'lu' or 'cg'; got {sparse_solver!r}")
+        self.sparse_solver = sparse_solver
         for part in (*self.constraints, *self.forces, *self.controllers):
             part._freeze()
         self.strict = bool(strict)
@@ -537,7 +545,7 @@ class System:
         if self.sparse:
             Aa = A @ a
             ac, lam, rank = uk.solve_sparse(
-                sp.csr_matrix(A), b - Aa, self._Minv_sp, self._Minv_sqrt_sp
+                sp.csr_matrix(A), b - Aa, self._Minv_sp, self._Minv_sqrt_sp, self.sparse_solver
             )
             residual = float(np.linalg.norm(A @ (a + ac) - b))
             norm_Aa = float(np.linalg.norm(Aa))
