@@ -50,6 +50,7 @@ class Body(abc.ABC):
     kind: ClassVar[str]
 
     __slots__ = ("_name",)
+    _name: str
 
     def __init__(self, name: str) -> None:
         object.__setattr__(self, "_name", _check_name(name))
@@ -91,6 +92,8 @@ class RigidBody(Body):
     dof = 6
     kind = "rigid"
     __slots__ = ("_J", "_mass")
+    _mass: float
+    _J: FloatArray
 
     def __init__(self, name: str, mass: float, inertia: Any) -> None:
         super().__init__(name)
@@ -131,6 +134,7 @@ class PointMass(Body):
     dof = 3
     kind = "point"
     __slots__ = ("_mass",)
+    _mass: float
 
     def __init__(self, name: str, mass: float) -> None:
         super().__init__(name)
@@ -164,6 +168,7 @@ class SlackCoordinate(Body):
     dof = 1
     kind = "slack"
     __slots__ = ("_mass",)
+    _mass: float
 
     def __init__(self, name: str, mass: float = 1.0) -> None:
         super().__init__(name)

@@ -99,7 +99,7 @@ class Accelerations:
     def of(self, body: Body | str, field: str = "total") -> FloatArray:
         """The slice of a per-dof field (e.g. "total", "constraint_force") for one body."""
         s = self.layout.slot(body)
-        return getattr(self, field)[s.offset : s.offset + s.dof]  # type: ignore[no-any-return]
+        return getattr(self, field)[s.offset : s.offset + s.dof]
 
 
 class System:
@@ -157,7 +157,12 @@ class System:
         if sparse_solver not in ("lu", "cg"):
             raise DefinitionError(f"sparse_solver must be 'lu' or 'cg'; got {sparse_solver!r}")
         self.sparse_solver = sparse_solver
-        for part in (*self.constraints, *self.forces, *self.controllers):
+        parts: list[Constraint | ForceModel | Controller] = [
+            *self.constraints,
+            *self.forces,
+            *self.controllers,
+        ]
+        for part in parts:
             part._freeze()
         self.strict = bool(strict)
         self.consistency_tol = float(consistency_tol)
@@ -272,8 +277,8 @@ class System:
     def mass_matrix(self) -> FloatArray:
         """The block-diagonal mass matrix M = 𝕀̄ (n_dof, n_dof), dense (SI units)."""
         if self.sparse:
-            return scipy.linalg.block_diag(*self._M_blocks)  # type: ignore[no-any-return]
-        return self._M_dense  # type: ignore[no-any-return]
+            return scipy.linalg.block_diag(*self._M_blocks)
+        return self._M_dense
 
     def _build_index(self) -> None:
         lay = self.layout
@@ -385,7 +390,7 @@ class System:
     # ------------------------------------------------------------------ dynamics
     def _apply_Minv(self, Q: FloatArray) -> FloatArray:
         if not self.sparse:
-            return self._Minv_dense @ Q  # type: ignore[no-any-return]
+            return self._Minv_dense @ Q
         out = np.empty_like(Q)
         if self.layout.n_rigid:
             Qr = Q[self._rigid_idx]
@@ -400,7 +405,7 @@ class System:
 
     def _apply_M(self, a: FloatArray) -> FloatArray:
         if not self.sparse:
-            return self._M_dense @ a  # type: ignore[no-any-return]
+            return self._M_dense @ a
         out = np.empty_like(a)
         if self.layout.n_rigid:
             ar = a[self._rigid_idx]
@@ -582,9 +587,7 @@ class System:
         return ac, np.zeros(0), None, residual, unreachable
 
     def _I_tilde_m14_for(self, rigid_indices: list[int]) -> FloatArray:
-        return scipy.linalg.block_diag(  # type: ignore[no-any-return]
-            *[self._I_tilde_m14_blocks[i] for i in rigid_indices]
-        )
+        return scipy.linalg.block_diag(*[self._I_tilde_m14_blocks[i] for i in rigid_indices])
 
     # ------------------------------------------------------------------ simulation
     def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:

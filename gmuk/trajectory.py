@@ -4,8 +4,9 @@ Arrays are time-first: ``t`` (N,), ``g_NB`` (N, n_rigid, 4, 4), ``V_B`` (N, n_ri
 point-mass and slack coordinates ``x``/``xdot`` (N, n_euclid), controller states ``z``
 (N, n_control), and the recorded generalized quantities (N, n_dof) in System body order:
 ``acceleration``, ``constraint_acceleration``, ``constraint_force`` (M ν̇_c: the constraint
-wrench [L; f] of each rigid body in its body frame), ``control_force`` and ``unmodeled_force``; ``multipliers`` (N, s),
-``residual`` (N,), ``rank`` (N,; −1 where not computed).
+wrench [L; f] of each rigid body in its body frame), ``control_force`` and
+``unmodeled_force``; ``multipliers`` (N, s), ``residual`` (N,), ``rank`` (N,; −1 where not
+computed).
 """
 
 from __future__ import annotations

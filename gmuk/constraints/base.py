@@ -81,9 +81,13 @@ class Constraint(abc.ABC):
     ...         return self.A, self.b
     """
 
+    _bodies: tuple[Body | str, ...]
+    _name: str
+    _frozen: bool
+
     def __init__(self, bodies: Sequence[Body | str], *, name: str | None = None) -> None:
         if isinstance(bodies, str) or not isinstance(bodies, Sequence):
-            bodies = [bodies]  # type: ignore[list-item]
+            bodies = [bodies]
         if len(bodies) == 0:
             raise DefinitionError(f"{type(self).__name__} needs at least one body")
         object.__setattr__(self, "_bodies", tuple(bodies))
@@ -93,7 +97,7 @@ class Constraint(abc.ABC):
     @property
     def bodies(self) -> tuple[Body | str, ...]:
         """The bodies (objects or names) this constraint acts on, in column order."""
-        return self._bodies  # type: ignore[no-any-return]
+        return self._bodies
 
     @property
     def body_names(self) -> tuple[str, ...]:
@@ -103,7 +107,7 @@ class Constraint(abc.ABC):
     @property
     def name(self) -> str:
         """Label of the constraint."""
-        return self._name  # type: ignore[no-any-return]
+        return self._name
 
     @abc.abstractmethod
     def rows(self, state: State) -> tuple[Any, Any]:

@@ -37,6 +37,11 @@ class Controller(abc.ABC):
     name : str, optional
     """
 
+    _bodies: tuple[Body | str, ...]
+    _name: str
+    _frozen: bool
+    n_states: int
+
     def __init__(
         self, bodies: Sequence[Body | str], *, n_states: int = 0, name: str | None = None
     ) -> None:
@@ -52,12 +57,12 @@ class Controller(abc.ABC):
     @property
     def bodies(self) -> tuple[Body | str, ...]:
         """The bodies it acts on."""
-        return self._bodies  # type: ignore[no-any-return]
+        return self._bodies
 
     @property
     def name(self) -> str:
         """Label of the controller."""
-        return self._name  # type: ignore[no-any-return]
+        return self._name
 
     def initial_state(self) -> FloatArray:
         """Initial internal state z(0), shape (n_states,); zeros unless overridden."""

@@ -40,6 +40,11 @@ class ForceModel(abc.ABC):
     name : str, optional
     """
 
+    _bodies: tuple[Body | str, ...] | None
+    _name: str
+    _frozen: bool
+    modeled: bool
+
     def __init__(
         self,
         bodies: Sequence[Body | str] | None = None,
@@ -57,12 +62,12 @@ class ForceModel(abc.ABC):
     @property
     def bodies(self) -> tuple[Body | str, ...] | None:
         """The bodies it acts on, or None for all rigid bodies and point masses."""
-        return self._bodies  # type: ignore[no-any-return]
+        return self._bodies
 
     @property
     def name(self) -> str:
         """Label of the force model."""
-        return self._name  # type: ignore[no-any-return]
+        return self._name
 
     @abc.abstractmethod
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> Any:

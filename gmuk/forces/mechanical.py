@@ -48,13 +48,16 @@ class AppliedWrench(ForceModel):
         super().__init__([body], modeled=modeled, name=name)
         if frame not in ("body", "inertial"):
             raise DefinitionError(f"frame must be 'body' or 'inertial'; got {frame!r}")
-        if not callable(wrench):
+        if callable(wrench):
+            self._fun: Callable[[float], Any] = wrench
+        else:
             w = np.asarray(wrench, dtype=float)
             if w.shape not in ((6,), (3,)) or not np.isfinite(w).all():
                 raise DefinitionError(
                     f"wrench must be a finite (6,) or (3,) array or a callable; got shape {w.shape}"
                 )
-        self._fun: Callable[[float], Any] = wrench if callable(wrench) else (lambda t, w=w: w)
+            w.setflags(write=False)
+            self._fun = lambda t: w
         self.frame = frame
 
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:

@@ -22,7 +22,7 @@ _T = float(_SERIES_BELOW)
 
 
 @njit(cache=True, inline="always")
-def _horner(coeffs: tuple, x: float) -> float:  # type: ignore[type-arg]
+def _horner(coeffs: tuple, x: float) -> float:
     acc = 0.0
     for c in coeffs:
         acc = acc * x + c
