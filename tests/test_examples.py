@@ -1,0 +1,34 @@
+"""Every example script runs and reports physically sensible figures."""
+
+from __future__ import annotations
+
+import runpy
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def run(name):
+    return runpy.run_path(str(EXAMPLES / name), run_name="example")["main"]()
+
+
+def test_every_example_is_covered_here():
+    scripts = {p.name for p in EXAMPLES.glob("*.py")}
+    assert scripts == set(CHECKS), "add a check for each new example"
+
+
+CHECKS = {
+    "free_rigid_body.py": lambda r: r["energy_drift"] < 1e-10 and r["orthogonality"] < 1e-13,
+    "spherical_pendulum.py": lambda r: r["radius_error_m"] < 1e-8 and r["mean_tension_N"] > 0,
+    "virtual_pair.py": lambda r: r["locked_components_max"] < 1e-9
+    and r["roll_vs_analytic"] < 1e-8,
+}
+
+
+@pytest.mark.parametrize("name", sorted(CHECKS))
+def test_example_runs(name, capsys):
+    result = run(name)
+    assert CHECKS[name](result), result
+    assert capsys.readouterr().out  # it printed its figures
