@@ -90,3 +90,12 @@ def test_simulate_rejects_bad_arguments():
         system.simulate(state, (0.0, 1.0), method="RK4")
     with pytest.raises(gmuk.errors.DefinitionError, match="method"):
         system.simulate(state, (0.0, 1.0), method="Euler")
+
+
+def test_progress_bar_appears_on_request_and_not_otherwise(capsys):
+    system, state = free_body()
+    system.simulate(state, (0.0, 2.0), progress=True)
+    assert "s(sim)" in capsys.readouterr().err
+    system.simulate(state, (0.0, 2.0), progress=False)
+    system.simulate(state, (0.0, 2.0))  # default: only on a terminal, and captured is not one
+    assert capsys.readouterr().err == ""
