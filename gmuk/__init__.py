@@ -23,7 +23,14 @@ from gmuk.constraints import (
 )
 from gmuk.control import Controller
 from gmuk.dynamics import spatial_inertia
-from gmuk.forces import AppliedWrench, ForceModel, SpringDamper, UniformGravity
+from gmuk.forces import (
+    AppliedWrench,
+    ForceModel,
+    GravityGradient,
+    PointMassGravity,
+    SpringDamper,
+    UniformGravity,
+)
 from gmuk.reference import ReferenceState, ReferenceTrajectory
 from gmuk.state import Layout, State
 from gmuk.system import Accelerations, System
@@ -42,10 +49,12 @@ __all__ = [
     "Constraint",
     "Controller",
     "ForceModel",
+    "GravityGradient",
     "HolonomicConstraint",
     "Layout",
     "NonholonomicConstraint",
     "PointMass",
+    "PointMassGravity",
     "ReferenceState",
     "ReferenceTrajectory",
     "RelativeConstraint",

@@ -19,6 +19,7 @@ __all__ = [
     "InertiaError",
     "NonFiniteError",
     "NotOnGroupError",
+    "OrbitError",
     "ShapeError",
     "SimulationError",
 ]
@@ -80,6 +81,11 @@ class SimulationError(GmukError, RuntimeError):
     def __init__(self, message: str, trajectory: object | None = None) -> None:
         super().__init__(message)
         self.trajectory = trajectory
+
+
+class OrbitError(GmukError, ValueError):
+    """Orbital elements or conic parameters are invalid or inconsistent (e < 0, a ≤ 0 for an
+    ellipse, a with a parabola, a true anomaly beyond a hyperbola's asymptote, ...)."""
 
 
 class GmukWarning(UserWarning):

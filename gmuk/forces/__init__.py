@@ -1,6 +1,14 @@
 """Force models: body-frame wrenches from gravity, springs, applied loads, plugins."""
 
 from gmuk.forces.base import ForceModel
+from gmuk.forces.gravity import GravityGradient, PointMassGravity
 from gmuk.forces.mechanical import AppliedWrench, SpringDamper, UniformGravity
 
-__all__ = ["AppliedWrench", "ForceModel", "SpringDamper", "UniformGravity"]
+__all__ = [
+    "AppliedWrench",
+    "ForceModel",
+    "GravityGradient",
+    "PointMassGravity",
+    "SpringDamper",
+    "UniformGravity",
+]
