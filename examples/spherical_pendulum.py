@@ -28,8 +28,9 @@ def main() -> dict[str, float]:
     # Start on the sphere with a velocity tangent to it: a conical-ish swing.
     r0 = length * np.array([np.sin(0.5), 0.0, -np.cos(0.5)])
     state = system.state(r={"bob": r0}, v={"bob": [0.0, 1.0, 0.0]})
-    traj = system.simulate(state, (0.0, 10.0), t_eval=np.linspace(0, 10, 201), rtol=1e-10,
-                           atol=1e-12)
+    traj = system.simulate(
+        state, (0.0, 10.0), t_eval=np.linspace(0, 10, 201), rtol=1e-10, atol=1e-12
+    )
     r = traj.body("bob").position
     tension = -traj.multipliers[:, 0] * 2 * length  # λ·∂φ/∂r = 2λ r: the rod force along r
     result = {

@@ -30,12 +30,16 @@ def main() -> dict[str, float]:
     torque = gmuk.AppliedWrench(craft, lambda t: [0.2 * np.sin(t), 0, 0, 0, 0, 0])
     system = gmuk.System(
         [virtual, craft],
-        [gmuk.ConfigurationTracking(virtual, ref),
-         gmuk.RelativeConstraint(craft, virtual, free_axes=[0])],
+        [
+            gmuk.ConfigurationTracking(virtual, ref),
+            gmuk.RelativeConstraint(craft, virtual, free_axes=[0]),
+        ],
         [torque],
     )
-    state = system.state(g={"virtual": np.eye(4), "spacecraft": np.eye(4)},
-                         V={"virtual": ref.xi, "spacecraft": ref.xi})
+    state = system.state(
+        g={"virtual": np.eye(4), "spacecraft": np.eye(4)},
+        V={"virtual": ref.xi, "spacecraft": ref.xi},
+    )
     t = np.linspace(0.0, 20.0, 201)
     traj = system.simulate(state, (0.0, 20.0), t_eval=t, rtol=1e-11, atol=1e-12)
     rel = se3.log(se3.inverse(traj.g_NB[:, 0]) @ traj.g_NB[:, 1])

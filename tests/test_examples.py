@@ -22,8 +22,7 @@ def test_every_example_is_covered_here():
 CHECKS = {
     "free_rigid_body.py": lambda r: r["energy_drift"] < 1e-10 and r["orthogonality"] < 1e-13,
     "spherical_pendulum.py": lambda r: r["radius_error_m"] < 1e-8 and r["mean_tension_N"] > 0,
-    "virtual_pair.py": lambda r: r["locked_components_max"] < 1e-9
-    and r["roll_vs_analytic"] < 1e-8,
+    "virtual_pair.py": lambda r: r["locked_components_max"] < 1e-9 and r["roll_vs_analytic"] < 1e-8,
 }
 
 
