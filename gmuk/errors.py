@@ -20,6 +20,7 @@ __all__ = [
     "NonFiniteError",
     "NotOnGroupError",
     "OrbitError",
+    "PluginWarning",
     "ShapeError",
     "SimulationError",
 ]
@@ -94,3 +95,7 @@ class GmukWarning(UserWarning):
 
 class InconsistentConstraintsWarning(GmukWarning, RuntimeWarning):
     """A ν̇ = b had no exact solution; the least-squares constraint acceleration was used."""
+
+
+class PluginWarning(GmukWarning):
+    """A force-model plugin could not be used and was skipped (the message says why)."""

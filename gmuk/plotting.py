@@ -1,0 +1,145 @@
+"""Figures of trajectories (matplotlib, imported lazily; files only, no windows).
+
+Every function writes one figure per call into ``out_dir`` in each requested format and
+returns the paths. Axes carry quantities and SI units; angles are plotted in degrees
+(labels say so), as are the thesis's figures.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray
+from gmuk.trajectory import Trajectory
+
+__all__ = ["compare_body", "plot_body"]
+
+_AXES = ("1", "2", "3")
+
+
+def _pyplot() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _figure(
+    t: FloatArray,
+    series: Sequence[tuple[str, FloatArray]],
+    ylabels: Sequence[str],
+    title: str,
+    out: Path,
+    formats: Sequence[str],
+    t_label: str = "t (s)",
+) -> list[Path]:
+    """A 3-row figure: one subplot per component, one line per series."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7.0, 6.5), constrained_layout=True)
+    for k, ax in enumerate(axes):
+        for label, y in series:
+            ax.plot(t, y[:, k], label=label, lw=1.2)
+        ax.set_ylabel(ylabels[k])
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel(t_label)
+    if len(series) > 1:
+        axes[0].legend(loc="best", fontsize=8)
+    fig.suptitle(title)
+    paths = []
+    for fmt in formats:
+        path = out.with_suffix(f".{fmt}")
+        fig.savefig(path, dpi=150)
+        paths.append(path)
+    plt.close(fig)
+    return paths
+
+
+def _quantities(traj: Trajectory, body: str) -> dict[str, tuple[FloatArray, list[str], str]]:
+    view = traj.body(body)
+    acc = view.constraint_acceleration
+    return {
+        "position": (view.position, [f"r{a} (m)" for a in _AXES], "Position in N"),
+        "velocity": (view.velocity, [f"v{a} (m/s)" for a in _AXES], "Velocity in N"),
+        "euler321": (
+            np.degrees(view.euler("321")),
+            ["ψ (deg)", "θ (deg)", "φ (deg)"],
+            "3-2-1 Euler angles of R_NB",
+        ),
+        "body_rates": (
+            view.omega,
+            [f"ω{a} (rad/s)" for a in _AXES],
+            "Angular velocity, body frame",
+        ),
+        "constraint_accel_translational": (
+            acc[:, 3:],
+            [f"a{a} (m/s²)" for a in _AXES],
+            "Translational constraint acceleration, body frame",
+        ),
+        "constraint_accel_rotational": (
+            acc[:, :3],
+            [f"α{a} (rad/s²)" for a in _AXES],
+            "Rotational constraint acceleration, body frame",
+        ),
+    }
+
+
+def plot_body(
+    traj: Trajectory,
+    body: str,
+    out_dir: Path,
+    formats: Sequence[str] = ("png",),
+    prefix: str = "",
+    label: str | None = None,
+) -> list[Path]:
+    """The six thesis figure groups of one rigid body: position, velocity, 3-2-1 Euler
+    angles, body rates, translational and rotational constraint accelerations."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    for key, (y, ylabels, title) in _quantities(traj, body).items():
+        paths += _figure(
+            traj.t,
+            [(label or body, y)],
+            ylabels,
+            f"{title} — {label or body}",
+            out_dir / f"{prefix}{key}",
+            formats,
+        )
+    return paths
+
+
+def compare_body(
+    a: Trajectory,
+    b: Trajectory,
+    body: str,
+    out_dir: Path,
+    formats: Sequence[str] = ("png",),
+    labels: tuple[str, str] = ("a", "b"),
+    difference: bool = True,
+    prefix: str = "",
+    body_b: str | None = None,
+) -> list[Path]:
+    """Compare one body in two runs sampled at the same times: the difference a − b of each
+    figure group (``difference=True``), or both overlaid."""
+    if a.t.shape != b.t.shape or np.abs(a.t - b.t).max(initial=0.0) > 1e-9 * max(1.0, a.t[-1]):
+        raise ValueError("compare_body needs both trajectories sampled at the same times")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    qa, qb = _quantities(a, body), _quantities(b, body_b or body)
+    paths: list[Path] = []
+    for key, (ya, ylabels, title) in qa.items():
+        yb = qb[key][0]
+        if difference:
+            series = [(f"{labels[0]} − {labels[1]}", ya - yb)]
+            ttl = f"{title}: {labels[0]} − {labels[1]}"
+            ylab = [f"Δ{s}" for s in ylabels]
+        else:
+            series = [(labels[0], ya), (labels[1], yb)]
+            ttl = f"{title}: {labels[0]} and {labels[1]}"
+            ylab = list(ylabels)
+        paths += _figure(a.t, series, ylab, ttl, out_dir / f"{prefix}{key}", formats)
+    return paths
