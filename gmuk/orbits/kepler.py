@@ -2,13 +2,13 @@
 
 Three "mean anomalies" are linear in the time ``t`` since periapsis passage:
 
-=========  ==========================  ======================  ===========================
-conic      mean anomaly                auxiliary anomaly       relation to the true anomaly
-=========  ==========================  ======================  ===========================
-ellipse    ``M = E − e sin E``         eccentric ``E``         ``tan(f/2) = √((1+e)/(1−e)) tan(E/2)``
-parabola   ``M_p = D + D³/3``          ``D = tan(f/2)``        (Barker's equation)
-hyperbola  ``M_h = e sinh H − H``      hyperbolic ``H``        ``tan(f/2) = √((e+1)/(e−1)) tanh(H/2)``
-=========  ==========================  ======================  ===========================
+=========  ======================  =============  =======================================
+conic      mean anomaly            auxiliary      relation to the true anomaly f
+=========  ======================  =============  =======================================
+ellipse    ``M = E − e sin E``     ``E``          ``tan(f/2) = √((1+e)/(1−e)) tan(E/2)``
+parabola   ``M_p = D + D³/3``      ``D``          ``D = tan(f/2)`` (Barker's equation)
+hyperbola  ``M_h = e sinh H − H``  ``H``          ``tan(f/2) = √((e+1)/(e−1)) tanh(H/2)``
+=========  ======================  =============  =======================================
 
 with ``M = n t``, ``n = √(μ/a³)`` (McCann 2020, Eqs. 75–78), ``M_p = 2√(μ/p³) t`` and
 ``M_h = √(μ/(−a)³) t`` (:mod:`gmuk.orbits.conics` applies these rates).
@@ -36,7 +36,7 @@ References
 ----------
 McCann (2020), Eqs. (75)–(78). Vallado, *Fundamentals of Astrodynamics and Applications*,
 4th ed. (2013), §2.2–2.3 (Algorithms 2–4, Barker's equation). Battin, *An Introduction to
-the Mathematics and Methods of Astrodynamics*, rev. ed. (1999), §4.3–4.5. Broucke &
+the Mathematics and Methods of Astrodynamics*, rev. ed. (1999), Ch. 4–5. Broucke &
 Cefola, "A note on the relations between true and eccentric anomalies in the two-body
 problem", *Celestial Mechanics* 7 (1973) 388–389 (the half-angle forms used here).
 """
@@ -78,7 +78,21 @@ _C2 = 6.357301884918343e-08
 _C3 = 2.4492935982947064e-16
 _MAX_REVS = 2.0**26
 _MAX_ITER = 60
-_EPS = np.finfo(np.float64).eps
+_EPS = float(np.finfo(np.float64).eps)
+# Newton stops once its predicted remaining error (quadratic and cubic terms of the step) is
+# below _STOP·|root|.
+_STOP = 0.05 * _EPS
+# 17!, 15!, ..., 3!: denominators of the series of x − sin x and sinh x − x (with 1/19!).
+_XMS_DEN = (
+    355687428096000.0,
+    1307674368000.0,
+    6227020800.0,
+    39916800.0,
+    362880.0,
+    5040.0,
+    120.0,
+    6.0,
+)
 
 
 def _angle(x: Any, name: str) -> FloatArray:
@@ -156,17 +170,8 @@ def _x_minus_sin(x: FloatArray) -> FloatArray:
     """``x − sin x`` without cancellation (Taylor series for |x| < 1)."""
     x2 = x * x
     # x³ Σ (−1)ᵏ x²ᵏ / (2k+3)!, k = 0..8: truncation < 1e-19 relative for |x| < 1.
-    s = 1.0 / 121645100408832000.0  # 1/19!
-    for d in (
-        355687428096000.0,
-        1307674368000.0,
-        6227020800.0,
-        39916800.0,
-        362880.0,
-        5040.0,
-        120.0,
-        6.0,
-    ):  # 17!, 15!, ..., 3!
+    s = np.full_like(x, 1.0 / 121645100408832000.0)  # 1/19!
+    for d in _XMS_DEN:  # 17!, 15!, ..., 3!
         s = 1.0 / d - x2 * s
     series = x * x2 * s
     return np.where(np.abs(x) < 1.0, series, x - np.sin(x))
@@ -175,17 +180,8 @@ def _x_minus_sin(x: FloatArray) -> FloatArray:
 def _sinh_minus_x(x: FloatArray) -> FloatArray:
     """``sinh x − x`` without cancellation (Taylor series for |x| < 1)."""
     x2 = x * x
-    s = 1.0 / 121645100408832000.0
-    for d in (
-        355687428096000.0,
-        1307674368000.0,
-        6227020800.0,
-        39916800.0,
-        362880.0,
-        5040.0,
-        120.0,
-        6.0,
-    ):
+    s = np.full_like(x, 1.0 / 121645100408832000.0)
+    for d in _XMS_DEN:
         s = 1.0 / d + x2 * s
     series = x * x2 * s
     with np.errstate(over="ignore"):
@@ -262,7 +258,7 @@ def eccentric_from_mean(M: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    McCann (2020), Eq. (77); Vallado (2013), Algorithm 2; Battin (1999), §5.1.
+    McCann (2020), Eq. (77); Vallado (2013), Algorithm 2; Battin (1999), Ch. 5.
     """
     M = _angle(M, "M")
     e = _check_elliptic_e(e)
@@ -289,7 +285,9 @@ def eccentric_from_mean(M: Any, e: Any) -> FloatArray:
         Enew = np.minimum(Ea - step, upper[active])
         Enew = np.maximum(Enew, 0.0)
         E[active] = Enew
-        still = np.abs(step) > 2.0 * _EPS * Enew
+        # Newton's error after this step: ≈ (f''/2f') step² + (f'''/6f') |step|³.
+        a_step = np.abs(step)
+        still = 0.5 * ea * (np.abs(s) + a_step / 3.0) * a_step**2 > _STOP * deriv * Enew
         idx = np.flatnonzero(active)
         active[idx[~still]] = False
         if not active.any():
@@ -420,7 +418,7 @@ def mean_from_parabolic(D: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), §2.2.4, Eq. (2-35); Battin (1999), §4.3.
+    Vallado (2013), §2.2 (Barker's equation); Battin (1999), Ch. 4.
     """
     D = as_array(D, (), "D")
     return D + D**3 / 3.0
@@ -446,7 +444,7 @@ def parabolic_from_mean(M_p: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), §2.2.4 (Barker's equation) and Algorithm 3.
+    Vallado (2013), §2.2 (Barker's equation) and Algorithm 3.
     """
     M = as_array(M_p, (), "M_p")
     x = np.abs(M)
@@ -524,7 +522,7 @@ def mean_from_hyperbolic(H: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), §2.2.6, Eq. (2-38); Battin (1999), §4.5.
+    Vallado (2013), §2.2; Battin (1999), Ch. 4.
     """
     H = as_array(H, (), "H")
     e = _check_hyperbolic_e(e)
@@ -555,7 +553,7 @@ def hyperbolic_from_mean(M_h: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), Algorithm 4; Battin (1999), §4.5.
+    Vallado (2013), Algorithm 4; Battin (1999), Ch. 4.
     """
     M = as_array(M_h, (), "M_h")
     e = _check_hyperbolic_e(e)
@@ -578,7 +576,9 @@ def hyperbolic_from_mean(M_h: Any, e: Any) -> FloatArray:
         step = resid / deriv
         Hnew = np.maximum(Ha - step, 0.0)
         H[active] = Hnew
-        still = np.abs(step) > 2.0 * _EPS * Hnew
+        a_step = np.abs(step)
+        curv = np.abs(np.sinh(Ha)) + np.cosh(Ha) * a_step / 3.0
+        still = 0.5 * ea * curv * a_step**2 > _STOP * deriv * Hnew
         idx = np.flatnonzero(active)
         active[idx[~still]] = False
         if not active.any():
@@ -603,7 +603,7 @@ def true_from_hyperbolic(H: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), §2.2.6, Eq. (2-37).
+    Vallado (2013), §2.2; Battin (1999), Ch. 4.
     """
     H = as_array(H, (), "H")
     e = _check_hyperbolic_e(e)
@@ -650,9 +650,6 @@ def hyperbolic_from_true(f: Any, e: Any) -> FloatArray:
 # evaluated at every integrator stage, where numpy's per-call overhead would dominate.
 # Callers validate e once; tests check these agree with the vectorised functions.
 
-_XMS_DEN = (355687428096000.0, 1307674368000.0, 6227020800.0, 39916800.0, 362880.0)
-_XMS_DEN += (5040.0, 120.0, 6.0)
-
 
 def _x_minus_sin_scalar(x: float) -> float:
     if abs(x) >= 1.0:
@@ -681,7 +678,7 @@ def _cubic_root_scalar(c1: float, c3: float, x: float) -> float:
 
 def eccentric_from_mean_scalar(M: float, e: float) -> float:
     """:func:`eccentric_from_mean` for one finite float M and ``0 ≤ e < 1`` (not checked)."""
-    k = round(M / _TWO_PI)
+    k = float(round(M / _TWO_PI))
     if abs(k) < _MAX_REVS:
         Mr = ((M - k * _C1) - k * _C2) - k * _C3
     else:
@@ -694,9 +691,12 @@ def eccentric_from_mean_scalar(M: float, e: float) -> float:
     E = min(E, upper)
     for _ in range(_MAX_ITER):
         resid = _x_minus_sin_scalar(E) + one_m_e * math.sin(E) - x
-        step = resid / (one_m_e + 2.0 * e * math.sin(0.5 * E) ** 2)
+        deriv = one_m_e + 2.0 * e * math.sin(0.5 * E) ** 2
+        step = resid / deriv
+        a_step = abs(step)
+        err = 0.5 * e * (abs(math.sin(E)) + a_step / 3.0) * a_step * a_step
         E = max(min(E - step, upper), 0.0)
-        if abs(step) <= 2.0 * _EPS * E:
+        if err <= _STOP * deriv * E:
             break
     Er = math.copysign(E, Mr)
     return ((Er + k * _C3) + k * _C2) + k * _C1
@@ -721,9 +721,12 @@ def hyperbolic_from_mean_scalar(M: float, e: float) -> float:
         H = math.asinh((x + H) / e)
     for _ in range(_MAX_ITER):
         resid = em1 * math.sinh(H) + _sinh_minus_x_scalar(H) - x
-        step = resid / (em1 + 2.0 * e * math.sinh(0.5 * H) ** 2)
+        deriv = em1 + 2.0 * e * math.sinh(0.5 * H) ** 2
+        step = resid / deriv
+        a_step = abs(step)
+        err = 0.5 * e * (abs(math.sinh(H)) + math.cosh(H) * a_step / 3.0) * a_step * a_step
         H = max(H - step, 0.0)
-        if abs(step) <= 2.0 * _EPS * H:
+        if err <= _STOP * deriv * H:
             break
     return math.copysign(H, M)
 
@@ -736,7 +739,7 @@ def true_from_hyperbolic_scalar(H: float, e: float) -> float:
 def parabolic_from_mean_scalar(M_p: float) -> float:
     """:func:`parabolic_from_mean` for one finite float."""
     x = abs(M_p)
-    s = math.cbrt(0.5 * (3.0 * x + math.hypot(3.0 * x, 2.0)))
+    s = (0.5 * (3.0 * x + math.hypot(3.0 * x, 2.0))) ** (1.0 / 3.0)
     D = 3.0 * x / (s * s + 1.0 + 1.0 / (s * s))
     if D < 1e100:
         D -= (D + D**3 / 3.0 - x) / (1.0 + D * D)
