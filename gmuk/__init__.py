@@ -11,6 +11,7 @@ The flow: parts (bodies, constraints, force models, controllers) → :class:`Sys
 
 from gmuk import errors, lie
 from gmuk.bodies import Body, PointMass, RigidBody, SlackCoordinate
+from gmuk.celestial import CelestialBody, UniformRotation
 from gmuk.constraints import (
     Baumgarte,
     ConfigurationTracking,
@@ -44,6 +45,7 @@ __all__ = [
     "Baumgarte",
     "Body",
     "BodyTrajectory",
+    "CelestialBody",
     "ConfigurationTracking",
     "ConfigurationTrackingT2",
     "Constraint",
@@ -66,6 +68,7 @@ __all__ = [
     "TangentBundleConstraint",
     "Trajectory",
     "UniformGravity",
+    "UniformRotation",
     "__version__",
     "errors",
     "lie",
