@@ -1,7 +1,7 @@
 """Force models: body-frame wrenches from gravity, springs, applied loads, plugins."""
 
 from gmuk.forces.base import ForceModel
-from gmuk.forces.gravity import GravityGradient, PointMassGravity
+from gmuk.forces.gravity import GravityGradient, PointMassGravity, SphericalHarmonicGravity
 from gmuk.forces.mechanical import AppliedWrench, SpringDamper, UniformGravity
 
 __all__ = [
@@ -9,6 +9,7 @@ __all__ = [
     "ForceModel",
     "GravityGradient",
     "PointMassGravity",
+    "SphericalHarmonicGravity",
     "SpringDamper",
     "UniformGravity",
 ]

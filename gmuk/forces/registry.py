@@ -31,6 +31,7 @@ _BUILTIN = {
     "applied_wrench": "gmuk.forces.mechanical:AppliedWrench",
     "gravity_gradient": "gmuk.forces.gravity:GravityGradient",
     "point_mass_gravity": "gmuk.forces.gravity:PointMassGravity",
+    "spherical_harmonic_gravity": "gmuk.forces.gravity:SphericalHarmonicGravity",
     "spring_damper": "gmuk.forces.mechanical:SpringDamper",
     "uniform_gravity": "gmuk.forces.mechanical:UniformGravity",
 }

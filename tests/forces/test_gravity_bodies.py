@@ -76,3 +76,41 @@ def test_point_mass_gravity_on_rigid_and_point_bodies():
 def test_gravity_models_reject_bad_mu():
     with pytest.raises(gmuk.errors.DefinitionError, match="mu"):
         gmuk.GravityGradient(-1.0)
+
+
+class PointField:
+    """A degree-0 'field': U = μ/r, for checking the rigid-body expansion against Eq. 23."""
+
+    def __init__(self, mu, radius=1.0):
+        self.mu, self.radius, self.degree = mu, radius, 0
+
+    def acceleration(self, r):
+        return -self.mu * r / np.linalg.norm(r) ** 3
+
+    def hessian(self, r):
+        n = np.linalg.norm(r)
+        u = r / n
+        return self.mu / n**3 * (3.0 * np.outer(u, u) - np.eye(3))
+
+
+def test_spherical_harmonic_model_with_a_point_field_equals_eq_23():
+    rng = np.random.default_rng(3)
+    moon = gmuk.CelestialBody("pt", field=PointField(MU), rotation=gmuk.UniformRotation(2.66e-6))
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    J = Q @ np.diag([3.0e8, 4.0e8, 5.0e8]) @ Q.T
+    body = gmuk.RigidBody("s", 1.0e6, J)
+    sh = gmuk.forces.SphericalHarmonicGravity(moon)
+    gg = gmuk.GravityGradient(MU)
+    for t in (0.0, 5.0e4):
+        g = se3.exp(rng.normal(size=6))
+        g[:3, 3] *= 2.0e5 / np.linalg.norm(g[:3, 3])  # 200 km: finite-size part ~1e-8
+        w_sh = sh.wrench(t, g, np.zeros(6), body)
+        w_gg = gg.wrench(t, g, np.zeros(6), body)
+        point = g[:3, :3].T @ (-MU * 1.0e6 * g[:3, 3] / np.linalg.norm(g[:3, 3]) ** 3)
+        assert np.linalg.norm(w_sh[:3] - w_gg[:3]) <= 1e-12 * np.linalg.norm(w_gg[:3])
+        assert np.linalg.norm(w_sh[3:] - w_gg[3:]) <= 1e-6 * np.linalg.norm(w_gg[3:] - point)
+
+
+def test_spherical_harmonic_gravity_needs_a_field():
+    with pytest.raises(gmuk.errors.DefinitionError, match="needs a CelestialBody with a field"):
+        gmuk.forces.SphericalHarmonicGravity(gmuk.CelestialBody.moon())
