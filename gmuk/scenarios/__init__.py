@@ -20,7 +20,13 @@ from gmuk.trajectory import Trajectory
 __all__ = ["SCENARIOS", "ScenarioResult", "describe", "load"]
 
 #: Scenario names and the modules implementing them, in the thesis's order.
-SCENARIOS: dict[str, str] = {}
+SCENARIOS: dict[str, str] = {
+    "fccn": "gmuk.scenarios.fccn",
+    "fcei": "gmuk.scenarios.fcei",
+    "fceim": "gmuk.scenarios.fceim",
+    "ucei": "gmuk.scenarios.ucei",
+    "uceis": "gmuk.scenarios.uceis",
+}
 
 
 @dataclass(frozen=True)
@@ -55,11 +61,6 @@ def load(name: str) -> ModuleType:
 def describe() -> list[tuple[str, str]]:
     """(name, one-line description) of every scenario."""
     return [(name, load(name).DESCRIPTION) for name in SCENARIOS]
-
-
-def register(name: str, module: str) -> None:
-    """Register a scenario module under ``name`` (used by gmuk's own scenario modules)."""
-    SCENARIOS[name] = module
 
 
 FigureFn = Callable[[ScenarioResult, Path, tuple[str, ...]], list[Path]]

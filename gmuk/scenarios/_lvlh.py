@@ -1,0 +1,202 @@
+"""Shared set-up of the Chapter 4 scenarios (McCann 2020, Sections 4.1.2–4.3).
+
+The spacecraft has the mass properties printed in Section 3.4; the central body is the Moon
+with μ = 4.9048695e12 m³/s² (the value that makes Section 4.3's printed initial condition
+consistent, ERRATA); the force model is the uniform-field gravity gradient (Eq. 23). The
+initial state is the reference's own at periselene (t = 0), computed from Eqs. 69–71 as
+corrected (it reproduces the printed numbers to all their digits with this μ).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import gmuk
+from gmuk import plotting
+from gmuk._validation import FloatArray
+from gmuk.lie import se3
+from gmuk.orbits import MU_MOON_THESIS_CONSISTENT, KeplerOrbit, LVLHReference
+from gmuk.scenarios import ScenarioResult
+from gmuk.trajectory import Trajectory
+
+#: Mass (kg) and central inertia (kg·m², body frame) of McCann (2020), Section 3.4.
+LM_MASS = 7063.0
+LM_INERTIA = np.array(
+    [
+        [17058.9014, 246.758867, 752.478961],
+        [246.758867, 18801.1275, 100.330528],
+        [752.478961, 100.330528, 21969.674],
+    ]
+)
+MU = MU_MOON_THESIS_CONSISTENT
+#: Integration tolerances that hold FCEI to ≤ 1e-6 m over an orbit (measured 4.2e-7 m).
+RTOL, ATOL = 3e-15, 1e-12
+SAMPLES_PER_ORBIT = 721
+
+
+def spacecraft(name: str = "spacecraft") -> gmuk.RigidBody:
+    """A rigid body with the Section 3.4 mass properties."""
+    return gmuk.RigidBody(name, LM_MASS, LM_INERTIA)
+
+
+def time_grid(orbit: KeplerOrbit, orbits: float) -> FloatArray:
+    """Output times (s from periselene): SAMPLES_PER_ORBIT per orbit, both ends included."""
+    n = max(2, int(round(SAMPLES_PER_ORBIT * orbits)))
+    return np.linspace(0.0, orbits * orbit.period, n)
+
+
+def fully_constrained(
+    orbit: KeplerOrbit,
+    orbits: float,
+    *,
+    tangent: bool = False,
+    baumgarte: gmuk.Baumgarte | None = None,
+) -> Trajectory:
+    """One spacecraft tracking the modified-LVLH reference: R⁶ (Eq. 67) or T²SE(3) (Eq. 80)."""
+    sc = spacecraft()
+    ref = LVLHReference(orbit)
+    con: gmuk.Constraint = (
+        gmuk.ConfigurationTrackingT2(sc, ref)
+        if tangent
+        else gmuk.ConfigurationTracking(sc, ref, baumgarte=baumgarte)
+    )
+    system = gmuk.System([sc], [con], [gmuk.GravityGradient(orbit.mu)])
+    r0 = ref.evaluate(0.0)
+    state = system.state(g={sc.name: r0.g}, V={sc.name: r0.V})
+    t = time_grid(orbit, orbits)
+    return system.simulate(state, (0.0, t[-1]), t_eval=t, rtol=RTOL, atol=ATOL)
+
+
+def virtual_pair(
+    orbit: KeplerOrbit, orbits: float, torque: Callable[[float], Any] | None = None
+) -> Trajectory:
+    """The under-constrained pair of Section 4.1.3: "virtual" tracks the reference, and
+    "spacecraft" is held to it in five relative directions, free to roll about axis 1."""
+    virtual, sc = spacecraft("virtual"), spacecraft()
+    ref = LVLHReference(orbit)
+    forces: list[gmuk.ForceModel] = [gmuk.GravityGradient(orbit.mu)]
+    if torque is not None:
+        forces.append(gmuk.AppliedWrench(sc, torque))
+    system = gmuk.System(
+        [virtual, sc],
+        [
+            gmuk.ConfigurationTracking(virtual, ref),
+            gmuk.RelativeConstraint(sc, virtual, free_axes=[0]),
+        ],
+        forces,
+    )
+    r0 = ref.evaluate(0.0)
+    state = system.state(
+        g={"virtual": r0.g, "spacecraft": r0.g}, V={"virtual": r0.V, "spacecraft": r0.V}
+    )
+    t = time_grid(orbit, orbits)
+    return system.simulate(state, (0.0, t[-1]), t_eval=t, rtol=RTOL, atol=ATOL)
+
+
+def reference_errors(
+    traj: Trajectory, orbit: KeplerOrbit, body: str = "spacecraft"
+) -> tuple[FloatArray, FloatArray]:
+    """Position error (m) against the analytic Kepler orbit and attitude error (rad) against
+    the reference attitude, at every output time."""
+    ref = LVLHReference(orbit).evaluate_many(traj.t)
+    view = traj.body(body)
+    pos = np.linalg.norm(view.position - ref.g[:, :3, 3], axis=1)
+    R_err = np.swapaxes(ref.g[:, :3, :3], 1, 2) @ view.R
+    att = np.linalg.norm(gmuk.lie.so3.log(R_err), axis=1)
+    return pos, att
+
+
+def relative_pose(
+    traj: Trajectory, body: str = "spacecraft", relative_to: str = "virtual"
+) -> FloatArray:
+    """log(g_L⁻¹ g_B) (N, 6): [rotation (rad); translation (m)] of B relative to L."""
+    g_L = traj.g_NB[:, traj.body_names.index(relative_to)]
+    g_B = traj.g_NB[:, traj.body_names.index(body)]
+    return se3.log(se3.inverse(g_L) @ g_B)
+
+
+def nominal_constraint_wrench(orbit: KeplerOrbit, t: FloatArray) -> FloatArray:
+    """Constraint wrench [L; f] (N, 6) (body frame) of the fully constrained spacecraft
+    evaluated *on* the reference states: what the constraint must supply on the constraint
+    manifold, free of integration error.
+
+    Its translational part is only the finite-size term of Eq. 23b (~5e-10 N here), below the
+    noise floor of the Eq. 67 rows off the reference (an attitude error of 3e-13 rad times the
+    0.7 m/s² centripetal term gives ~1e-9 N), so the simulated force cannot resolve it.
+    """
+    sc = spacecraft()
+    ref = LVLHReference(orbit)
+    system = gmuk.System(
+        [sc], [gmuk.ConfigurationTracking(sc, ref)], [gmuk.GravityGradient(orbit.mu)]
+    )
+    out = np.empty((len(t), 6))
+    for k, tk in enumerate(t):
+        r = ref.evaluate(float(tk))
+        out[k] = system.accelerations(
+            system.state(g={sc.name: r.g}, V={sc.name: r.V}, t=float(tk))
+        ).constraint_force
+    return out
+
+
+def fully_constrained_summary(traj: Trajectory, orbit: KeplerOrbit) -> dict[str, Any]:
+    """Headline figures of a fully constrained run (acceptance of issue #5)."""
+    pos, att = reference_errors(traj, orbit)
+    view = traj.body("spacecraft")
+    nominal = nominal_constraint_wrench(orbit, traj.t)
+    f_c = np.linalg.norm(nominal[:, 3:], axis=1)
+    i_min = int(np.argmin(f_c))
+    sim = np.linalg.norm(view.constraint_force[:, 3:], axis=1)
+    return {
+        "max_position_error_m": float(pos.max()),
+        "max_attitude_error_rad": float(att.max()),
+        "max_abs_omega1_omega2_rad_s": float(np.abs(view.omega[:, :2]).max()),
+        "nominal_translational_constraint_force_min_N": float(f_c[i_min]),
+        "nominal_translational_constraint_force_max_N": float(f_c.max()),
+        "time_of_min_nominal_constraint_force_s": float(traj.t[i_min]),
+        # Eq. 23b's finite-size force ∝ |r|⁻⁴ with r̂ fixed in the LVLH body frame:
+        "nominal_force_r4_law_max_relative_deviation": float(
+            np.abs(
+                f_c
+                * np.linalg.norm(view.position, axis=1) ** 4
+                / np.mean(f_c * np.linalg.norm(view.position, axis=1) ** 4)
+                - 1.0
+            ).max()
+        ),
+        "simulated_translational_constraint_force_max_N": float(sim.max()),
+        "max_constraint_torque_deviation_from_nominal_N_m": float(
+            np.abs(view.constraint_force[:, :3] - nominal[:, :3]).max()
+        ),
+        "max_constraint_torque_N_m": float(np.abs(nominal[:, :3]).max()),
+        "aposelene_time_s": float(orbit.period / 2),
+        "rhs_evaluations": int(traj.stats["n_rhs"]),
+        "steps": int(traj.stats["n_steps"]),
+    }
+
+
+def figures_for(
+    result: ScenarioResult,
+    out: Path,
+    formats: Sequence[str],
+    comparisons: Sequence[tuple[str, str, bool]] = (),
+) -> list[Path]:
+    """The thesis figure groups of the primary run, and for each (a, b, difference) in
+    ``comparisons`` the difference a − b (or both overlaid) of the spacecraft."""
+    trajs = result.trajectories
+    paths = plotting.plot_body(
+        trajs[result.primary], "spacecraft", out, formats, label=result.primary.upper()
+    )
+    for a, b, difference in comparisons:
+        paths += plotting.compare_body(
+            trajs[a],
+            trajs[b],
+            "spacecraft",
+            out / f"{a}_vs_{b}",
+            formats,
+            labels=(a.upper(), b.upper()),
+            difference=difference,
+        )
+    return paths

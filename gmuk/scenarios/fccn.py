@@ -1,0 +1,39 @@
+"""FCCN: fully constrained, circular, non-inclined lunar orbit (McCann 2020, §4.3.1.1).
+
+a = 4000 km, e = 0, i = 0. On a circular orbit the constraint wrench is constant.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmuk.orbits import fccn_orbit
+from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import _lvlh as common
+
+NAME = "fccn"
+DESCRIPTION = "fully constrained LVLH tracking on a circular equatorial orbit, a = 4000 km"
+
+
+def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
+    """Simulate ``orbits`` orbits."""
+    orbit = fccn_orbit(common.MU)
+    traj = common.fully_constrained(orbit, orbits)
+    summary = common.fully_constrained_summary(traj, orbit)
+    torque = traj.body("spacecraft").constraint_force[:, :3]
+    summary["constraint_torque_relative_variation"] = float(
+        np.ptp(torque, axis=0).max() / np.abs(torque).max()
+    )
+    nominal = common.nominal_constraint_wrench(orbit, traj.t)
+    summary["nominal_constraint_wrench_relative_variation"] = float(
+        np.ptp(nominal, axis=0).max() / np.abs(nominal).max()
+    )
+    return ScenarioResult(NAME, {NAME: traj}, NAME, summary)
+
+
+def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
+    """Position, velocity, Euler angles, body rates, constraint accelerations."""
+    return common.figures_for(result, out, formats)

@@ -1,0 +1,29 @@
+"""FCEI: fully constrained, elliptical, inclined lunar orbit on R⁶ (McCann 2020, §4.3.1.2).
+
+a = 4000 km, e = 0.2, i = 35°, Ω = ω = 0; the spacecraft is held in the modified-LVLH
+attitude (axis 1 at the Moon, axis 3 along the orbit normal) by Eq. 67 rows, A = I₆.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from gmuk.orbits import fcei_orbit
+from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import _lvlh as common
+
+NAME = "fcei"
+DESCRIPTION = "fully constrained LVLH tracking, a = 4000 km, e = 0.2, i = 35° (Eq. 67, R⁶)"
+
+
+def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
+    """Simulate ``orbits`` orbits from periselene."""
+    orbit = fcei_orbit(common.MU)
+    traj = common.fully_constrained(orbit, orbits)
+    return ScenarioResult(NAME, {NAME: traj}, NAME, common.fully_constrained_summary(traj, orbit))
+
+
+def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
+    """Position, velocity, Euler angles, body rates, constraint accelerations."""
+    return common.figures_for(result, out, formats)
