@@ -45,7 +45,7 @@ def spacecraft(name: str = "spacecraft") -> gmuk.RigidBody:
 
 def time_grid(orbit: KeplerOrbit, orbits: float) -> FloatArray:
     """Output times (s from periselene): SAMPLES_PER_ORBIT per orbit, both ends included."""
-    n = max(2, int(round(SAMPLES_PER_ORBIT * orbits)))
+    n = max(2, round(SAMPLES_PER_ORBIT * orbits))
     return np.linspace(0.0, orbits * orbit.period, n)
 
 
