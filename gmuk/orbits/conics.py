@@ -164,15 +164,16 @@ class KeplerOrbit:
         -------
         orbit : KeplerOrbit
         t : float
-            Time since periapsis passage (s) at which ``orbit.state(t) == (r_N, v_N)``; in
-            ``[0, T)`` for an ellipse. For circular or equatorial orbits the angles follow
-            the conventions of :mod:`gmuk.orbits.elements` (periapsis at the node or at N₁).
+            Time since periapsis passage (s) at which ``orbit.state(t) == (r_N, v_N)``; for
+            an ellipse the nearest periapsis is used, ``t ∈ [−T/2, T/2)``. For circular or
+            equatorial orbits the angles follow the conventions of
+            :mod:`gmuk.orbits.elements` (periapsis at the node or at N₁).
         """
         r = as_array(r_N, (3,), "r_N", batch=False)
         v = as_array(v_N, (3,), "v_N", batch=False)
         el = state_to_elements(r, v, mu)
         orbit = cls(float(el.p), float(el.e), float(el.i), float(el.raan), float(el.argp), mu)
-        return orbit, float(orbit.time_from_true_anomaly(float(el.nu)))
+        return orbit, float(orbit.time_from_true_anomaly(kepler.wrap_to_pi(el.nu)))
 
     # ------------------------------------------------------------------ constants
 

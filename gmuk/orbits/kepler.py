@@ -16,7 +16,7 @@ with ``M = n t``, ``n = √(μ/a³)`` (McCann 2020, Eqs. 75–78), ``M_p = 2√(
 Angle wrapping
 --------------
 Elliptic anomalies are *not* wrapped: every conversion returns the angle on the same
-revolution as its input, so that ``E − M = e sin E ∈ [−e, e]`` and ``f − E ∈ (−π, π)``.
+revolution as its input, so that ``E − M = e sin E ∈ [−e, e]`` and ``|f − E| < π``.
 The maps ``M ↦ E ↦ f`` are therefore continuous and increasing on the whole real line
 (``t ↦ f(t)`` never jumps), and ``M = 2πk`` gives ``E = f = 2πk``. Use :func:`wrap_to_2pi`
 or :func:`wrap_to_pi` to reduce an angle afterwards. The parabolic and hyperbolic true
@@ -36,9 +36,7 @@ References
 ----------
 McCann (2020), Eqs. (75)–(78). Vallado, *Fundamentals of Astrodynamics and Applications*,
 4th ed. (2013), §2.2–2.3 (Algorithms 2–4, Barker's equation). Battin, *An Introduction to
-the Mathematics and Methods of Astrodynamics*, rev. ed. (1999), Ch. 4–5. Broucke &
-Cefola, "A note on the relations between true and eccentric anomalies in the two-body
-problem", *Celestial Mechanics* 7 (1973) 388–389 (the half-angle forms used here).
+the Mathematics and Methods of Astrodynamics*, rev. ed. (1999), Ch. 4–5.
 """
 
 from __future__ import annotations
@@ -270,10 +268,11 @@ def eccentric_from_mean(M: Any, e: Any) -> FloatArray:
     one_m_e = 1.0 - e
     # Lower bound: (E − e sin E) ≤ (1 − e)E + (e/6)E³. Where e is tiny the cubic term is
     # negligible and x itself is the start.
-    with np.errstate(divide="ignore", invalid="ignore"):
-        E = np.where(e > 1e-8, _cubic_root(one_m_e, e / 6.0, x), x)
+    E = x.copy()
+    cubic = e > 1e-8
+    E[cubic] = _cubic_root(one_m_e[cubic], e[cubic] / 6.0, x[cubic])
     upper = np.minimum(x + e, np.pi)
-    E = np.array(np.minimum(E, upper), dtype=np.float64)
+    E = np.minimum(E, upper)
     active = np.ones(E.shape, dtype=bool)
     for _ in range(_MAX_ITER):
         Ea = E[active]
@@ -296,12 +295,18 @@ def eccentric_from_mean(M: Any, e: Any) -> FloatArray:
     return _unreduce(Er, k).reshape(shape)
 
 
-def true_from_eccentric(E: Any, e: Any) -> FloatArray:
-    """True anomaly of an ellipse from its eccentric anomaly.
+def _same_revolution(wrapped: FloatArray, ref: FloatArray) -> FloatArray:
+    """``wrapped + 2πk`` with k such that the result lies within π of ``ref``."""
+    return wrapped + _TWO_PI * np.round((ref - wrapped) / _TWO_PI)
 
-    Uses ``f = E + 2 atan(β sin E / (1 − β cos E))``, ``β = e / (1 + √(1 − e²))``, which is
-    equivalent to McCann (2020), Eq. (78), ``tan(f/2) = √((1+e)/(1−e)) tan(E/2)``, but has
-    no branch cut: f is on the same revolution as E, with ``|f − E| < π``.
+
+def true_from_eccentric(E: Any, e: Any) -> FloatArray:
+    """True anomaly of an ellipse from its eccentric anomaly (McCann 2020, Eq. 78).
+
+    Eq. (78), ``tan(f/2) = √((1+e)/(1−e)) tan(E/2)``, is evaluated as
+    ``f = atan2(√(1 − e²) sin E, cos E − e)`` with ``cos E − e = (1 − e) − 2 sin²(E/2)``
+    (no cancellation as ``e → 1``) and put on the revolution of E (``|f − E| < π``), so
+    the map has no branch cut and is continuous and increasing in E.
 
     Parameters
     ----------
@@ -317,19 +322,21 @@ def true_from_eccentric(E: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    McCann (2020), Eq. (78); Broucke & Cefola (1973).
+    McCann (2020), Eq. (78); Vallado (2013), §2.2; Battin (1999), Ch. 4.
     """
     E = _angle(E, "E")
     e = _check_elliptic_e(e)
-    beta = e / (1.0 + np.sqrt((1.0 - e) * (1.0 + e)))
-    return E + 2.0 * np.arctan2(beta * np.sin(E), 1.0 - beta * np.cos(E))
+    wrapped = np.arctan2(
+        np.sqrt((1.0 - e) * (1.0 + e)) * np.sin(E), (1.0 - e) - 2.0 * np.sin(0.5 * E) ** 2
+    )
+    return _same_revolution(wrapped, E)
 
 
 def eccentric_from_true(f: Any, e: Any) -> FloatArray:
     """Eccentric anomaly of an ellipse from its true anomaly (inverse of Eq. 78).
 
-    ``E = f − 2 atan(β sin f / (1 + β cos f))``, ``β = e / (1 + √(1 − e²))``; E is on the
-    same revolution as f.
+    ``E = atan2(√(1 − e²) sin f, e + cos f)`` with ``e + cos f = 2 cos²(f/2) − (1 − e)``,
+    put on the revolution of f (``|E − f| < π``).
 
     Parameters
     ----------
@@ -345,12 +352,14 @@ def eccentric_from_true(f: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    McCann (2020), Eq. (78); Broucke & Cefola (1973).
+    McCann (2020), Eq. (78); Vallado (2013), §2.2; Battin (1999), Ch. 4.
     """
     f = _angle(f, "f")
     e = _check_elliptic_e(e)
-    beta = e / (1.0 + np.sqrt((1.0 - e) * (1.0 + e)))
-    return f - 2.0 * np.arctan2(beta * np.sin(f), 1.0 + beta * np.cos(f))
+    wrapped = np.arctan2(
+        np.sqrt((1.0 - e) * (1.0 + e)) * np.sin(f), 2.0 * np.cos(0.5 * f) ** 2 - (1.0 - e)
+    )
+    return _same_revolution(wrapped, f)
 
 
 def true_from_mean(M: Any, e: Any) -> FloatArray:
@@ -638,7 +647,7 @@ def hyperbolic_from_true(f: Any, e: Any) -> FloatArray:
     if bad.any():
         j = np.flatnonzero(bad.ravel())[0]
         raise OrbitError(
-            "a hyperbola's true anomaly must satisfy |f| < arccos(−1/e); got "
+            "true anomaly beyond the asymptote: a hyperbola needs |f| < arccos(−1/e); got "
             f"f = {float(f.ravel()[j])!r} with e = {float(e.ravel()[j])!r} "
             f"(limit {float(np.arccos(-1.0 / e.ravel()[j]))!r})"
         )
@@ -704,8 +713,10 @@ def eccentric_from_mean_scalar(M: float, e: float) -> float:
 
 def true_from_eccentric_scalar(E: float, e: float) -> float:
     """:func:`true_from_eccentric` for floats (e not checked)."""
-    beta = e / (1.0 + math.sqrt((1.0 - e) * (1.0 + e)))
-    return E + 2.0 * math.atan2(beta * math.sin(E), 1.0 - beta * math.cos(E))
+    w = math.atan2(
+        math.sqrt((1.0 - e) * (1.0 + e)) * math.sin(E), (1.0 - e) - 2.0 * math.sin(0.5 * E) ** 2
+    )
+    return w + _TWO_PI * round((E - w) / _TWO_PI)
 
 
 def hyperbolic_from_mean_scalar(M: float, e: float) -> float:
