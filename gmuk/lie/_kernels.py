@@ -13,12 +13,13 @@ import math
 import numpy as np
 from numba import njit
 
-from gmuk.lie._coeffs import _C_SERIES, _D_SERIES, _E_SERIES, _SERIES_BELOW
+from gmuk.lie._coeffs import _C_SERIES, _D_SERIES, _DE_SERIES_BELOW, _E_SERIES, _SERIES_BELOW
 
 _C = tuple(float(c) for c in _C_SERIES)  # highest power first (np.polyval order)
 _D = tuple(float(c) for c in _D_SERIES)
 _E = tuple(float(c) for c in _E_SERIES)
 _T = float(_SERIES_BELOW)
+_TDE = float(_DE_SERIES_BELOW)
 
 
 @njit(cache=True, inline="always")
@@ -52,7 +53,7 @@ def _c(t: float) -> float:
 @njit(cache=True)
 def _d(t: float) -> float:
     """(1 − (θ/2) cot(θ/2))/θ²."""
-    if t < _T:
+    if t < _TDE:
         return _horner(_D, t * t)
     h = 0.5 * t
     return (1.0 - h / math.tan(h)) / (t * t)
@@ -61,7 +62,7 @@ def _d(t: float) -> float:
 @njit(cache=True)
 def _f1_f2(t: float) -> tuple[float, float]:
     d = _d(t)
-    if t < _T:
+    if t < _TDE:
         e = _horner(_E, t * t)
     else:
         e = (d - 1.0 / 12.0) / (t * t)

@@ -249,7 +249,7 @@ def dexp_inv(xi: Any) -> FloatArray:
     Notes
     -----
     F₁ and F₂ cancel catastrophically as θ → 0 when evaluated as printed; gmuk evaluates
-    them through exact rearrangements with Taylor series below θ = 1 (see
+    them through exact rearrangements with Taylor series below θ = 2 (see
     :mod:`gmuk.lie._coeffs`), accurate to round-off for every θ in [0, 2π).
     """
     return _dexp_inv(as_array(xi, (6,), "xi"))
