@@ -30,13 +30,20 @@ __all__ = ["SEQUENCES", "from_matrix", "to_matrix"]
 Sequence = Literal["321", "313"]
 SEQUENCES: tuple[str, ...] = ("321", "313")
 
-# Below this |cos θ| (321) or |sin i| (313), the attitude is treated as singular.
-_GIMBAL_TOL = 1e-12
+# Below this |cos θ| (321) or |sin i| (313), the attitude is treated as singular. The angles
+# returned there reproduce R to about 2 × _GIMBAL_TOL.
+_GIMBAL_TOL = 1e-14
 
 
 def _check_seq(seq: str) -> None:
     if seq not in SEQUENCES:
         raise EulerSequenceError(f"seq must be one of {SEQUENCES}; got {seq!r}")
+
+
+def _atan2(y: FloatArray, x: FloatArray) -> FloatArray:
+    """atan2 with values in (−π, π]: −π (from y = −0.0 or a rounded residual) becomes π."""
+    a = np.arctan2(y, x)
+    return np.where(a <= -np.pi, np.pi, a)
 
 
 def _axis_rotation(axis: int, a: FloatArray) -> FloatArray:
@@ -96,17 +103,23 @@ def from_matrix(R: Any, seq: Sequence = "321") -> FloatArray:
         regular = cth > _GIMBAL_TOL
         psi = np.where(
             regular,
-            np.arctan2(R[..., 1, 0], R[..., 0, 0]),
+            _atan2(R[..., 1, 0], R[..., 0, 0]),
             # θ = ±π/2: R = R₃(ψ ∓ φ)-like; with φ = 0, ψ from the second column.
-            np.arctan2(-R[..., 0, 1], R[..., 1, 1]),
+            _atan2(-R[..., 0, 1], R[..., 1, 1]),
         )
-        phi = np.where(regular, np.arctan2(R[..., 2, 1], R[..., 2, 2]), 0.0)
+        # φ from the residual R₁(φ) = (R₃(ψ) R₂(θ))ᵀ R, not from row 3 of R alone: near
+        # gimbal lock ψ and φ are each ill-conditioned (error ε/cos θ) and only this keeps
+        # the three angles consistent, so that they reproduce R to round-off.
+        M = np.swapaxes(_axis_rotation(2, psi) @ _axis_rotation(1, th), -1, -2) @ R
+        phi = np.where(regular, _atan2(M[..., 2, 1], M[..., 1, 1]), 0.0)
         return np.stack([psi, th, phi], axis=-1)
     sin_i = np.hypot(R[..., 0, 2], R[..., 1, 2])
     inc = np.arctan2(sin_i, R[..., 2, 2])
     regular = sin_i > _GIMBAL_TOL
     raan = np.where(
-        regular, np.arctan2(R[..., 0, 2], -R[..., 1, 2]), np.arctan2(R[..., 1, 0], R[..., 0, 0])
+        regular, _atan2(R[..., 0, 2], -R[..., 1, 2]), _atan2(R[..., 1, 0], R[..., 0, 0])
     )
-    argp = np.where(regular, np.arctan2(R[..., 2, 0], R[..., 2, 1]), 0.0)
+    # ω from the residual R₃(ω) = (R₃(Ω) R₁(i))ᵀ R (see the 3-2-1 case).
+    M = np.swapaxes(_axis_rotation(2, raan) @ _axis_rotation(0, inc), -1, -2) @ R
+    argp = np.where(regular, _atan2(M[..., 1, 0], M[..., 0, 0]), 0.0)
     return np.stack([raan, inc, argp], axis=-1)
