@@ -9,7 +9,7 @@ References
 ----------
 McCann (2020), Section 4.1.2 (ḟ, f̈, v̇_{d/P} and Eqs. 75–78; all correct as printed, see
 ERRATA). Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed. (2013),
-§2.2–2.3 (Kepler's problem for each conic).
+Ch. 2 (Kepler's problem for each conic).
 """
 
 from __future__ import annotations

@@ -31,7 +31,7 @@ in ``(−ν∞, ν∞)``, ``ν∞ = arccos(−1/e)`` (negative before periapsis)
 
 References
 ----------
-Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed. (2013), §2.5–2.6,
+Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed. (2013), Ch. 2,
 Algorithms 9 (RV2COE) and 10 (COE2RV); Curtis, *Orbital Mechanics for Engineering
 Students*, 3rd ed. (2014), Algorithms 4.2 and 4.5. McCann (2020), Eqs. (69)–(70).
 """
@@ -193,7 +193,7 @@ def R_NP(raan: Any, i: Any, argp: Any) -> FloatArray:
 
     References
     ----------
-    McCann (2020), Section 4.1.2 (text below Eq. 70); Vallado (2013), §2.6 (the
+    McCann (2020), Section 4.1.2 (text below Eq. 70); Vallado (2013), Ch. 2 (the
     PQW → IJK transformation of COE2RV).
     """
     W = as_array(raan, (), "raan")

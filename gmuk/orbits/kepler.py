@@ -35,7 +35,7 @@ equation is treated the same way.
 References
 ----------
 McCann (2020), Eqs. (75)–(78). Vallado, *Fundamentals of Astrodynamics and Applications*,
-4th ed. (2013), §2.2–2.3 (Algorithms 2–4, Barker's equation). Battin, *An Introduction to
+4th ed. (2013), Ch. 2 (Algorithms 2–4, Barker's equation). Battin, *An Introduction to
 the Mathematics and Methods of Astrodynamics*, rev. ed. (1999), Ch. 4–5.
 """
 
@@ -327,7 +327,7 @@ def true_from_eccentric(E: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    McCann (2020), Eq. (78); Vallado (2013), §2.2; Battin (1999), Ch. 4.
+    McCann (2020), Eq. (78); Vallado (2013), Ch. 2; Battin (1999), Ch. 4.
     """
     E = _angle(E, "E")
     e = _check_elliptic_e(e)
@@ -357,7 +357,7 @@ def eccentric_from_true(f: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    McCann (2020), Eq. (78); Vallado (2013), §2.2; Battin (1999), Ch. 4.
+    McCann (2020), Eq. (78); Vallado (2013), Ch. 2; Battin (1999), Ch. 4.
     """
     f = _angle(f, "f")
     e = _check_elliptic_e(e)
@@ -432,7 +432,7 @@ def mean_from_parabolic(D: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), §2.2 (Barker's equation); Battin (1999), Ch. 4.
+    Vallado (2013), Ch. 2 (Barker's equation); Battin (1999), Ch. 4.
     """
     D = as_array(D, (), "D")
     return D + D**3 / 3.0
@@ -458,7 +458,7 @@ def parabolic_from_mean(M_p: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), §2.2 (Barker's equation) and Algorithm 3.
+    Vallado (2013), Ch. 2 (Barker's equation) and Algorithm 3.
     """
     M = as_array(M_p, (), "M_p")
     x = np.abs(M)
@@ -536,7 +536,7 @@ def mean_from_hyperbolic(H: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), §2.2; Battin (1999), Ch. 4.
+    Vallado (2013), Ch. 2; Battin (1999), Ch. 4.
     """
     H = as_array(H, (), "H")
     e = _check_hyperbolic_e(e)
@@ -617,7 +617,7 @@ def true_from_hyperbolic(H: Any, e: Any) -> FloatArray:
 
     References
     ----------
-    Vallado (2013), §2.2; Battin (1999), Ch. 4.
+    Vallado (2013), Ch. 2; Battin (1999), Ch. 4.
     """
     H = as_array(H, (), "H")
     e = _check_hyperbolic_e(e)

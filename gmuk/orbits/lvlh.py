@@ -40,7 +40,7 @@ References
 McCann (2020), Section 4.1.2, Eqs. (68)–(78), and Section 4.3 (initial condition);
 ``ERRATA.md`` (Eq. 69 transposed, Eq. 72 translational part, Eq. 74 signs, μ_Moon of
 Section 4.3). Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed. (2013),
-§2.6 (perifocal frame) and §3.3 (RSW / LVLH frames).
+Ch. 2 (perifocal frame) and Ch. 3 (the satellite RSW frame).
 """
 
 from __future__ import annotations
