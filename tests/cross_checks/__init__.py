@@ -1,0 +1,1 @@
+"""Cross-checks of gmuk against independent implementations (Pinocchio)."""
