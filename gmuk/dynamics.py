@@ -27,6 +27,8 @@ __all__ = [
 #: Relative tolerance for symmetry of J and for the triangle inequalities of its moments.
 INERTIA_TOL = 1e-9
 
+_TWO_COLUMNS = np.ones(2)
+
 
 def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatArray]:
     """Validate a mass and a central inertia tensor.
@@ -130,16 +132,16 @@ def free_acceleration(V: Any, inertia: Any, wrench: Any = None) -> FloatArray:
     """
     V = as_array(V, (6,), "V")
     I = as_array(inertia, (6, 6), "inertia")
-    w, v = V[..., :3], V[..., 3:]
     h = (I @ V[..., None])[..., 0]
     # ad*_V 𝕀V = [h_ang × ω + h_lin × v; h_lin × ω]. For 𝕀 = blkdiag(J, mI) the term
     # h_lin × v = m v × v vanishes, but evaluated as written it leaves a spurious torque of
-    # order ε m|v|² (1e-5 N·m for 500 kg at 7 km/s). Its isotropic part I₃₃ v, whose cross
-    # product with v is exactly zero, is therefore removed first (exact for any 𝕀).
-    h_lin_rel = h[..., 3:] - I[..., 3, 3][..., None] * v
-    rhs = np.concatenate(
-        [np.cross(h[..., :3], w) + np.cross(h_lin_rel, v), np.cross(h[..., 3:], w)], axis=-1
-    )
+    # order ε m|v|² (1e-5 N·m for 500 kg at 7 km/s). For the torque row, the isotropic part
+    # I₃₃ v of h_lin, whose cross product with v is exactly zero, is removed first.
+    H = h[..., None] * _TWO_COLUMNS
+    H[..., 3:, 0] -= I[..., 3, 3][..., None] * V[..., 3:]
+    both = np.swapaxes(se3._ad(V), -1, -2) @ H
+    rhs = both[..., 1]
+    rhs[..., :3] = both[..., :3, 0]
     if wrench is not None:
         rhs = rhs + as_array(wrench, (6,), "wrench")
     return np.linalg.solve(I, rhs[..., None])[..., 0]
