@@ -155,7 +155,7 @@ class _Problem:
     def scale(
         self, Y0: FloatArray, Y1: FloatArray, G0: FloatArray, rtol: float, atol: float
     ) -> FloatArray:
-        """Error weights: ξ's rotation part against 1 rad, its translation against |r|."""
+        """Error weights: ξ's rotation part against 1 rad, its translation against ‖r‖."""
         sc = atol + rtol * np.maximum(np.abs(Y0), np.abs(Y1))
         if self.nr:
             r = np.abs(G0[:, :3, 3])
@@ -280,8 +280,8 @@ def simulate(
         Output times within t_span (increasing). Default: every accepted step.
     method : {"DOP853", "DOPRI5", "RK4"}
     rtol, atol : float
-        Relative and absolute tolerances (adaptive methods). Error weights use |r| (m) for
-        the translational part of ξ and 1 rad for its rotational part.
+        Relative and absolute tolerances (adaptive methods). Error weights use the distance
+        ``‖r‖`` (m) for the translational part of ξ and 1 rad for its rotational part.
     step : float
         Step size (s) for RK4 (required there); ignored otherwise.
     first_step, max_step : float, optional

@@ -118,6 +118,13 @@ class System:
         Sparse solve of A M⁻¹ Aᵀ λ = r: direct LU (exact; best for chain- or mesh-like
         coupling) or conjugate gradients (best for large, randomly coupled systems); see
         :func:`gmuk.uk.solve_sparse`.
+    tangent_bundle_method : {"reachable", "eq80"}
+        How a :class:`~gmuk.constraints.TangentBundleConstraint` is solved. "reachable"
+        (default) restricts ``A g̈ B = C`` to reachable accelerations ``g(V^² + V̇^)`` and
+        solves the resulting R⁶ rows by Gauss's principle (:func:`gmuk.uk.reachable_rows`);
+        "eq80" applies McCann (2020) Eq. 80 as printed and projects each body's block of
+        g̈_c onto g·se(3) (``Accelerations.unreachable`` says how much it discarded). They
+        agree for full tracking (A = B = I₄).
     strict : bool
         Raise :class:`gmuk.errors.InconsistentConstraintsError` on inconsistent constraints
         instead of warning.
@@ -141,6 +148,7 @@ class System:
         *,
         sparse: bool | str = "auto",
         sparse_solver: str = "lu",
+        tangent_bundle_method: str = "reachable",
         strict: bool = False,
         consistency_tol: float = 1e-8,
         rcond: float | None = None,
@@ -156,6 +164,12 @@ class System:
             raise DefinitionError(f"sparse must be 'auto', True or False; got {sparse!r}")
         if sparse_solver not in ("lu", "cg"):
             raise DefinitionError(f"sparse_solver must be 'lu' or 'cg'; got {sparse_solver!r}")
+        if tangent_bundle_method not in ("reachable", "eq80"):
+            raise DefinitionError(
+                f"tangent_bundle_method must be 'reachable' or 'eq80'; got "
+                f"{tangent_bundle_method!r}"
+            )
+        self.tangent_bundle_method = tangent_bundle_method
         self.sparse_solver = sparse_solver
         parts: list[Constraint | ForceModel | Controller] = [
             *self.constraints,
@@ -545,6 +559,12 @@ class System:
         self, state: State, a: FloatArray
     ) -> tuple[FloatArray, FloatArray, int | None, float]:
         A, b = self.constraint_rows(state)
+        return self._solve_rows(state, a, A, b)
+
+    def _solve_rows(
+        self, state: State, a: FloatArray, A: Any, b: FloatArray
+    ) -> tuple[FloatArray, FloatArray, int | None, float]:
+        """UK solve of given rows, with the consistency check."""
         if b.size == 0:
             return np.zeros_like(a), np.zeros(0), 0, 0.0
         if self.sparse:
@@ -571,11 +591,17 @@ class System:
 
     def _solve_t2(
         self, state: State, a: FloatArray
-    ) -> tuple[FloatArray, FloatArray, None, float, float]:
+    ) -> tuple[FloatArray, FloatArray, int | None, float, float]:
         (c,) = self.constraints
         assert isinstance(c, TangentBundleConstraint)
         A, B, C = (np.asarray(x, dtype=float) for x in c.tangent_rows(state))
         idx = [self.layout.slot(bd).index for bd in c.bodies]
+        if self.tangent_bundle_method == "reachable":
+            A6, b6 = uk.reachable_rows(A, B, C, state.g[idx], state.V[idx])
+            A_full = np.zeros((A6.shape[0], self.layout.n_dof))
+            A_full[:, self._rigid_idx[idx].ravel()] = A6
+            ac, lam, rank, residual = self._solve_rows(state, a, A_full, b6)
+            return ac, lam, rank, residual, 0.0
         g = state.g[idx]
         Vh = se3._hat(state.V[idx])
         a_r = a[self._rigid_idx[idx]]

@@ -22,7 +22,13 @@ from gmuk import _uk_kernels
 from gmuk._validation import FloatArray
 from gmuk.lie import se3
 
-__all__ = ["matrix_power_spd", "solve_dense", "solve_sparse", "solve_tangent_bundle"]
+__all__ = [
+    "matrix_power_spd",
+    "reachable_rows",
+    "solve_dense",
+    "solve_sparse",
+    "solve_tangent_bundle",
+]
 
 
 def solve_dense(
@@ -186,3 +192,42 @@ def solve_tangent_bundle(
     Gdd = Gdd_a + projected
     residual = float(np.linalg.norm(A @ Gdd @ B - C)) / max(float(np.linalg.norm(C)), 1.0)
     return V_dot_c, unreachable, residual
+
+
+def reachable_rows(
+    A: FloatArray, B: FloatArray, C: FloatArray, g: FloatArray, V: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """``A g̈ B = C`` restricted to reachable accelerations, as R⁶ rows in the body twists.
+
+    Every reachable g̈ is ``g̈_i = g_i (V_i^² + V̇_i^)`` (Eqs. 17–19), so the constraint is
+    linear in ``V̇``: ``Σ_i A_i g_i V̇_i^ B_i = C − Σ_i A_i g_i V_i^² B_i``, with A_i, B_i the
+    blocks of A, B belonging to body i. Solving these rows by Gauss's principle (Eq. 64)
+    is the Udwadia–Kalaba solution of the T²SE(3) constraint within the reachable set; it
+    is the projection gmuk uses where Eq. 80's g̈_c is not reachable (ERRATA).
+
+    Parameters
+    ----------
+    A : ndarray (m, 4k)
+    B : ndarray (4k, p)
+    C : ndarray (m, p)
+    g : ndarray (k, 4, 4)
+        Poses of the constraint's bodies.
+    V : ndarray (k, 6)
+        Their body twists.
+
+    Returns
+    -------
+    A6 : ndarray (m·p, 6k)
+        Rows acting on [V̇₁; …; V̇ₖ].
+    b6 : ndarray (m·p,)
+    """
+    k = g.shape[0]
+    E = se3._hat(np.eye(6))  # (6, 4, 4): the se(3) basis
+    rhs = np.array(C, dtype=float)
+    cols = []
+    for i in range(k):
+        Ai, Bi = A[:, 4 * i : 4 * i + 4], B[4 * i : 4 * i + 4, :]
+        Vh = se3._hat(V[i])
+        rhs = rhs - Ai @ g[i] @ Vh @ Vh @ Bi
+        cols.append(np.stack([(Ai @ g[i] @ E[j] @ Bi).ravel() for j in range(6)], axis=1))
+    return np.hstack(cols), rhs.ravel()

@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
 
-__all__ = ["ConfigurationTrackingT2", "TangentBundleConstraint"]
+__all__ = ["ConfigurationTrackingT2", "TangentBundleConstraint", "VirtualPairT2"]
 
 
 class TangentBundleConstraint(Constraint):
@@ -76,3 +76,75 @@ class ConfigurationTrackingT2(TangentBundleConstraint):
         ref = self.reference.evaluate(state.t)
         Vd = se3._hat(ref.V)
         return np.eye(4), np.eye(4), ref.g @ (Vd @ Vd + se3._hat(ref.V_dot))
+
+
+_X = np.eye(4)[:3]  # rows 1–3: drop the (zero) last row of g̈
+_Y = np.eye(4)[:, [0, 3]]  # columns 1 and 4: E₁^ Y = 0, so roll about axis 1 drops out
+
+
+class VirtualPairT2(TangentBundleConstraint):
+    """The virtual-spacecraft pair of McCann (2020) Section 4.1.3, on T²SE(3).
+
+    Beyond the thesis (its future work). With ``g̈ = blkdiag(g̈_L, g̈_B)``:
+
+    * L tracks the reference: ``g̈_L = g̈_d``;
+    * B stays at L rotated about their common first axis, ``g_B = g_L h``,
+      ``h = exp(φ e₁^)``: from ``g̈_B = g̈_L h + 2 ġ_L ḣ + g_L ḧ`` and
+      ``ḧ = h (V_rel^² + V̇_rel^)``, the five non-roll components of ``V̇_rel`` vanish iff
+      ``X (g̈_B − g̈_L h) Y = X (2 ġ_L ḣ + g_L h V_rel^²) Y`` with ``X = [I₃ 0]`` and
+      ``Y = [e₁ e₄]`` (``X g_B W^ Y = [R_B(w × e₁), R_B u]``, zero iff W is a pure roll).
+
+    Stacked into one ``A g̈ B = C`` (Eq. 79)::
+
+        A = [[I₄, 0], [−X, X]]        B = [[I₄, h Y], [0, Y]]
+        C = [[g̈_d, g̈_d h Y], [−X g̈_d, X (2 ġ_L ḣ + g_L h V_rel^²) Y]]
+
+    (the off-diagonal blocks of C repeat the first constraint, as A g̈ B produces them).
+
+    Parameters
+    ----------
+    body : Body or str
+        The spacecraft B, free to roll about its first axis relative to L.
+    relative_to : Body or str
+        The virtual body L that tracks ``reference``.
+    reference : ReferenceTrajectory
+    name : str, optional
+    """
+
+    def __init__(
+        self,
+        body: Body | str,
+        relative_to: Body | str,
+        reference: ReferenceTrajectory,
+        *,
+        name: str | None = None,
+    ) -> None:
+        super().__init__([relative_to, body], name=name)
+        if not isinstance(reference, ReferenceTrajectory):
+            raise DefinitionError(
+                f"reference must be a gmuk.ReferenceTrajectory; got {type(reference).__name__}"
+            )
+        self.reference = reference
+
+    def tangent_rows(self, state: State) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """(A (7, 8), B (8, 6), C (7, 6)) for [L, B]."""
+        L, Bd = self.bodies
+        g_L, V_L, g_B, V_B = state.pose(L), state.twist(L), state.pose(Bd), state.twist(Bd)
+        ref = self.reference.evaluate(state.t)
+        Vd = se3._hat(ref.V)
+        gdd_d = ref.g @ (Vd @ Vd + se3._hat(ref.V_dot))
+        h = se3._inverse(g_L) @ g_B
+        V_rel = V_B - se3._Ad(se3._inverse(h)) @ V_L
+        Vr = se3._hat(V_rel)
+        gL_dot = g_L @ se3._hat(V_L)
+        h_dot = h @ Vr
+        Z = np.zeros((4, 4))
+        A = np.block([[np.eye(4), Z], [-_X, _X]])
+        B = np.block([[np.eye(4), h @ _Y], [Z, _Y]])
+        C = np.block(
+            [
+                [gdd_d, gdd_d @ h @ _Y],
+                [-_X @ gdd_d, _X @ (2.0 * gL_dot @ h_dot + g_L @ h @ Vr @ Vr) @ _Y],
+            ]
+        )
+        return A, B, C

@@ -26,6 +26,7 @@ SCENARIOS: dict[str, str] = {
     "fceim": "gmuk.scenarios.fceim",
     "ucei": "gmuk.scenarios.ucei",
     "uceis": "gmuk.scenarios.uceis",
+    "uceim": "gmuk.scenarios.uceim",
 }
 
 

@@ -59,10 +59,18 @@ def test_uceis_rolls_under_the_torque_while_the_orbit_is_unchanged():
     assert uceis["max_velocity_difference_vs_fcei_m_s"] <= 1e-9
 
 
+def test_uceim_pair_on_t2se3_agrees_with_ucei_and_eq80_is_not_reachable():
+    s = scenarios.load("uceim").run(orbits=0.25).summary
+    assert s["max_position_difference_vs_ucei_m"] <= 1e-6
+    assert s["max_roll_difference_vs_ucei_rad"] <= 1e-9
+    assert s["max_relative_locked_components"] <= 1e-9
+    assert s["eq80_unreachable_fraction_min"] > 0.1  # measured 0.35–0.47 over an orbit
+
+
 def test_cli_list_and_run_write_trajectory_summary_and_figures(tmp_path, capsys):
     assert cli.main(["list"]) == 0
     listed = capsys.readouterr().out
-    assert all(name in listed for name in ("fccn", "fcei", "fceim", "ucei", "uceis"))
+    assert all(n in listed for n in ("fccn", "fcei", "fceim", "ucei", "uceis", "uceim"))
     out = tmp_path / "run"
     assert (
         cli.main(["run", "fcei", "--orbits", "0.05", "--out", str(out), "--format", "png,pdf"]) == 0
@@ -81,11 +89,13 @@ def test_cli_reports_bad_input_clearly(capsys):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["fccn", "fcei", "fceim", "ucei", "uceis"])
+@pytest.mark.parametrize("name", ["fccn", "fcei", "fceim", "ucei", "uceis", "uceim"])
 def test_full_orbit_scenarios(name):
     s = scenarios.load(name).run(orbits=1.0).summary
     if name in ("fccn", "fcei", "fceim"):
         assert s["max_position_error_m"] <= 1e-6 and s["max_attitude_error_rad"] <= 1e-10
+    elif name == "uceim":
+        assert s["max_position_difference_vs_ucei_m"] <= 1e-6
     else:
         assert s["max_position_difference_vs_fcei_m"] <= 1e-6
 
