@@ -19,6 +19,9 @@ from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
 
+# NOTE: gmuk.lie._kernels freezes these constants into numba's on-disk cache, which is keyed on
+# _kernels.py only. After changing a constant here, touch _kernels.py (or clear its
+# __pycache__) so that the kernels recompile; the mpmath tests fail on stale kernels.
 _SERIES_BELOW = 1.0
 
 # C(θ) = (θ − sin θ)/θ³ = Σ_k (−1)^k θ^{2k} / (2k+3)!
