@@ -105,6 +105,9 @@ class Layout:
 class State:
     """A snapshot of a System at time ``t``.
 
+    Use the accessors (:meth:`pose`, :meth:`twist`, :meth:`position`, :meth:`velocity`)
+    with a body or its name rather than indexing the arrays.
+
     Attributes
     ----------
     t : float
@@ -121,9 +124,6 @@ class State:
         Controllers' internal states.
     layout : Layout
         Index of the bodies.
-
-    Use the accessors (:meth:`pose`, :meth:`twist`, :meth:`position`, :meth:`velocity`)
-    with a body or its name rather than indexing the arrays.
     """
 
     t: float

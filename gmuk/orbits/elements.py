@@ -13,7 +13,7 @@ Section 4.1.2: "the 3-1-3 Euler angle rotation matrix from the perifocal frame t
 inertial frame").
 
 Conventions for the special cases (:func:`state_to_elements`)
------------------------------------------------------------
+-------------------------------------------------------------
 An element that is undefined is set to 0 and the angle it would have carried moves into
 the next one, so that ``elements_to_state(state_to_elements(r, v))`` always gives back
 ``(r, v)``:
