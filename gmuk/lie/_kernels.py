@@ -291,7 +291,8 @@ def dexp_matrix(xi: np.ndarray) -> np.ndarray:
         Jr = np.eye(3) - _b(t) * T + _c(t) * (T @ T)
         out[k, :3, :3] = Jr
         out[k, 3:, 3:] = Jr
-        out[k, 3:, :3] = -(Jr @ inv[k, 3:, :3]) @ Jr
+        Y = np.ascontiguousarray(inv[k, 3:, :3])
+        out[k, 3:, :3] = -(Jr @ Y) @ Jr
     return out
 
 
