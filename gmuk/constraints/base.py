@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._frozen import FreezesInSystem
 from gmuk._validation import FloatArray
 from gmuk.errors import DefinitionError
 
@@ -57,7 +58,7 @@ class Baumgarte:
         return Baumgarte(alpha=2.0 * omega_n, beta=omega_n**2)
 
 
-class Constraint(abc.ABC):
+class Constraint(FreezesInSystem, abc.ABC):
     """A set of s constraint rows ``A ν̇ = b`` on some bodies.
 
     Subclass it and implement :meth:`rows`. The bodies are given as :class:`gmuk.Body`
@@ -83,7 +84,6 @@ class Constraint(abc.ABC):
 
     _bodies: tuple[Body | str, ...]
     _name: str
-    _frozen: bool
 
     def __init__(self, bodies: Sequence[Body | str], *, name: str | None = None) -> None:
         if isinstance(bodies, str) or not isinstance(bodies, Sequence):
@@ -92,7 +92,6 @@ class Constraint(abc.ABC):
             raise DefinitionError(f"{type(self).__name__} needs at least one body")
         object.__setattr__(self, "_bodies", tuple(bodies))
         object.__setattr__(self, "_name", name or type(self).__name__)
-        object.__setattr__(self, "_frozen", False)
 
     @property
     def bodies(self) -> tuple[Body | str, ...]:
@@ -119,16 +118,6 @@ class Constraint(abc.ABC):
         b : array_like, shape (s,)
             In SI units of acceleration (rad/s², m/s², …) times those of A.
         """
-
-    def _freeze(self) -> None:
-        object.__setattr__(self, "_frozen", True)
-
-    def __setattr__(self, key: str, value: Any) -> None:
-        if getattr(self, "_frozen", False):
-            raise AttributeError(
-                f"{self.name} is frozen: it belongs to a System; build a new constraint instead"
-            )
-        object.__setattr__(self, key, value)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(bodies={list(self.body_names)}, name={self.name!r})"

@@ -89,11 +89,28 @@ def _stencil1(f: Callable[[float], FloatArray], h: float) -> FloatArray:
     return (f(-2 * h) - 8.0 * f(-h) + 8.0 * f(h) - f(2 * h)) / (12.0 * h)
 
 
-class _Differentiable:
-    """Shared finite-difference machinery for residual-based constraints."""
+class _Differentiable(Constraint):
+    """Shared construction and finite-difference machinery for residual-based constraints."""
 
     fd_length: float
     fd_time: float
+    baumgarte: Baumgarte | None
+
+    def __init__(
+        self,
+        bodies: Sequence[Body | str],
+        *,
+        baumgarte: Baumgarte | None = None,
+        fd_length: float = 1.0,
+        fd_time: float = 1.0,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(bodies, name=name)
+        if not (fd_length > 0 and fd_time > 0):
+            raise ConstraintError(f"fd_length and fd_time must be > 0; got {fd_length}, {fd_time}")
+        self.baumgarte = baumgarte
+        self.fd_length = float(fd_length)
+        self.fd_time = float(fd_time)
 
     def _steps(self, kind: str, dof: int) -> FloatArray:
         if kind == "rigid":
@@ -133,7 +150,7 @@ class _Differentiable:
         return np.stack(cols, axis=-1)
 
 
-class HolonomicConstraint(_Differentiable, Constraint):
+class HolonomicConstraint(_Differentiable):
     """A holonomic constraint ``φ(q, t) = 0`` given by its residual.
 
     Subclasses implement :meth:`residual`; optionally :meth:`jacobian` and :meth:`bias`
@@ -164,22 +181,6 @@ class HolonomicConstraint(_Differentiable, Constraint):
     ...         x_b = g_b[:3, :3] @ self.p_b + g_b[:3, 3]
     ...         return np.array([np.dot(x_a - x_b, x_a - x_b) - self.d**2])
     """
-
-    def __init__(
-        self,
-        bodies: Sequence[Body | str],
-        *,
-        baumgarte: Baumgarte | None = None,
-        fd_length: float = 1.0,
-        fd_time: float = 1.0,
-        name: str | None = None,
-    ) -> None:
-        super().__init__(bodies, name=name)
-        if not (fd_length > 0 and fd_time > 0):
-            raise ConstraintError(f"fd_length and fd_time must be > 0; got {fd_length}, {fd_time}")
-        self.baumgarte = baumgarte
-        self.fd_length = float(fd_length)
-        self.fd_time = float(fd_time)
 
     @abc.abstractmethod
     def residual(self, q: Config, t: float) -> Any:
@@ -221,7 +222,7 @@ class HolonomicConstraint(_Differentiable, Constraint):
         return A, b
 
 
-class NonholonomicConstraint(_Differentiable, Constraint):
+class NonholonomicConstraint(_Differentiable):
     """A velocity-level constraint ``ψ(q, ν, t) = 0`` given by its residual.
 
     ``A = ∂ψ/∂ν`` and ``b = −(d/dτ) ψ(q ⊕ τν, ν, t + τ)`` at τ = 0, by finite differences
@@ -236,22 +237,6 @@ class NonholonomicConstraint(_Differentiable, Constraint):
         Scales for the finite-difference steps, as for :class:`HolonomicConstraint`.
     name : str, optional
     """
-
-    def __init__(
-        self,
-        bodies: Sequence[Body | str],
-        *,
-        baumgarte: Baumgarte | None = None,
-        fd_length: float = 1.0,
-        fd_time: float = 1.0,
-        name: str | None = None,
-    ) -> None:
-        super().__init__(bodies, name=name)
-        if not (fd_length > 0 and fd_time > 0):
-            raise ConstraintError(f"fd_length and fd_time must be > 0; got {fd_length}, {fd_time}")
-        self.baumgarte = baumgarte
-        self.fd_length = float(fd_length)
-        self.fd_time = float(fd_time)
 
     @abc.abstractmethod
     def residual(self, q: Config, nu: Config, t: float) -> Any:

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._frozen import FreezesInSystem
 from gmuk._validation import FloatArray
 from gmuk.errors import DefinitionError
 
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
 __all__ = ["Controller"]
 
 
-class Controller(abc.ABC):
+class Controller(FreezesInSystem, abc.ABC):
     """A feedback law producing control wrenches.
 
     Parameters
@@ -39,7 +40,6 @@ class Controller(abc.ABC):
 
     _bodies: tuple[Body | str, ...]
     _name: str
-    _frozen: bool
     n_states: int
 
     def __init__(
@@ -52,7 +52,6 @@ class Controller(abc.ABC):
         object.__setattr__(self, "_bodies", tuple(bodies))
         object.__setattr__(self, "n_states", int(n_states))
         object.__setattr__(self, "_name", name or type(self).__name__)
-        object.__setattr__(self, "_frozen", False)
 
     @property
     def bodies(self) -> tuple[Body | str, ...]:
@@ -84,11 +83,3 @@ class Controller(abc.ABC):
             body (N·m, N), f_N (3,) for a point mass.
         z_dot : array_like, shape (n_states,)
         """
-
-    def _freeze(self) -> None:
-        object.__setattr__(self, "_frozen", True)
-
-    def __setattr__(self, key: str, value: Any) -> None:
-        if getattr(self, "_frozen", False):
-            raise AttributeError(f"{self.name} is frozen: it belongs to a System")
-        object.__setattr__(self, key, value)

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._frozen import FreezesInSystem
 from gmuk._validation import FloatArray
 
 if TYPE_CHECKING:
@@ -24,7 +25,7 @@ if TYPE_CHECKING:
 __all__ = ["ForceModel"]
 
 
-class ForceModel(abc.ABC):
+class ForceModel(FreezesInSystem, abc.ABC):
     """A source of wrenches on bodies.
 
     Subclasses implement :meth:`wrench` for one body at a time; models that couple bodies
@@ -42,7 +43,6 @@ class ForceModel(abc.ABC):
 
     _bodies: tuple[Body | str, ...] | None
     _name: str
-    _frozen: bool
     modeled: bool
 
     def __init__(
@@ -57,7 +57,6 @@ class ForceModel(abc.ABC):
         object.__setattr__(self, "_bodies", None if bodies is None else tuple(bodies))
         object.__setattr__(self, "modeled", bool(modeled))
         object.__setattr__(self, "_name", name or type(self).__name__)
-        object.__setattr__(self, "_frozen", False)
 
     @property
     def bodies(self) -> tuple[Body | str, ...] | None:
@@ -103,14 +102,6 @@ class ForceModel(abc.ABC):
                 w = self.wrench(state.t, g, V, body)
             out.append(np.asarray(w, dtype=float))
         return out
-
-    def _freeze(self) -> None:
-        object.__setattr__(self, "_frozen", True)
-
-    def __setattr__(self, key: str, value: Any) -> None:
-        if getattr(self, "_frozen", False):
-            raise AttributeError(f"{self.name} is frozen: it belongs to a System")
-        object.__setattr__(self, key, value)
 
     def __repr__(self) -> str:
         who = (
