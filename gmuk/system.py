@@ -298,7 +298,10 @@ class System:
         lay = self.layout
         self._rigid_idx = (lay.rigid_offsets[:, None] + np.arange(6)).reshape(-1, 6)
         self._constraint_cols = [lay.columns(c.bodies) for c in self.constraints]
-        self._all_cols = np.arange(lay.n_dof)
+        # One constraint spanning every dof in order: its A is the System's A as it stands.
+        self._single_full_width = len(self._constraint_cols) == 1 and np.array_equal(
+            self._constraint_cols[0], np.arange(lay.n_dof)
+        )
         self._force_bodies: list[list[Body]] = []
         for f in self.forces:
             if f.bodies is None:
@@ -498,12 +501,7 @@ class System:
                 shape=(s, n),
             )
             return A_sp, b
-        if (
-            len(blocks) == 1
-            and self._constraint_cols[0].size == n
-            and not sp.issparse(blocks[0][0])
-            and np.array_equal(self._constraint_cols[0], self._all_cols)
-        ):
+        if self._single_full_width and not sp.issparse(blocks[0][0]):
             return np.ascontiguousarray(blocks[0][0]), b
         A = np.zeros((s, n))
         r0 = 0

@@ -14,10 +14,11 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from gmuk._frozen import FreezesInSystem
 from gmuk._validation import FloatArray
-from gmuk.errors import DefinitionError
+from gmuk.errors import ConstraintError, DefinitionError
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body
@@ -128,11 +129,9 @@ def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[Any, FloatArray]:
 
     A may be dense (array_like) or a scipy.sparse matrix (kept sparse, as CSR).
     """
-    import scipy.sparse as sp
-
-    from gmuk.errors import ConstraintError
-
-    if sp.issparse(A):
+    if type(A) is np.ndarray and A.dtype == np.float64 and A.ndim == 2:
+        finite_A = bool(np.isfinite(A).all())
+    elif sp.issparse(A):
         A = sp.csr_matrix(A, dtype=float)
         finite_A = bool(np.isfinite(A.data).all())
     else:
@@ -140,7 +139,8 @@ def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[Any, FloatArray]:
         if A.ndim == 1:
             A = A[None, :]
         finite_A = bool(np.isfinite(A).all())
-    b = np.asarray(b, dtype=float)
+    if type(b) is not np.ndarray or b.dtype != np.float64:
+        b = np.asarray(b, dtype=float)
     if b.ndim == 0:
         b = b[None]
     if A.ndim != 2 or A.shape[1] != n_cols or b.shape != (A.shape[0],):
