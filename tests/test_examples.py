@@ -20,6 +20,9 @@ def test_every_example_is_covered_here():
 
 
 CHECKS = {
+    "custom_orbit_tracking.py": lambda r: (
+        r["max_position_error_m"] < 1e-5 and r["max_constraint_torque_N_m"] > 0
+    ),
     "free_rigid_body.py": lambda r: r["energy_drift"] < 1e-10 and r["orthogonality"] < 1e-13,
     "spherical_pendulum.py": lambda r: r["radius_error_m"] < 1e-8 and r["mean_tension_N"] > 0,
     "virtual_pair.py": lambda r: r["locked_components_max"] < 1e-9 and r["roll_vs_analytic"] < 1e-8,
