@@ -11,8 +11,6 @@ from gmuk.errors import NonFiniteError, NotOnGroupError, ShapeError
 
 FloatArray = NDArray[np.float64]
 
-_LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
-
 #: Tolerance for RᵀR = I and for the homogeneous row of SE(3) elements.
 GROUP_TOL = 1e-9
 
@@ -62,6 +60,21 @@ def _fmt(tail: tuple[int, ...], batch: bool) -> str:
     return f"(..., {inner})" if batch else f"({inner}{',' if len(tail) == 1 else ''})"
 
 
+def _rotation_failure(
+    name: str, tol: float, err: float, R: FloatArray, batch_shape: tuple, k: int
+) -> NotOnGroupError:
+    where = (
+        f" at index {tuple(int(j) for j in np.unravel_index(k, batch_shape))}"
+        if batch_shape
+        else ""
+    )
+    det = float(np.linalg.det(R))
+    return NotOnGroupError(
+        f"{name} must be a rotation matrix (RᵀR = I to {tol:g}, det +1){where}; "
+        f"got max|RᵀR − I| = {err:.3g}, det = {det:.6g}"
+    )
+
+
 def check_rotation(R: Any, name: str = "R", tol: float = GROUP_TOL) -> FloatArray:
     """Return ``R`` as an array of rotation matrices, or raise :class:`NotOnGroupError`.
 
@@ -76,31 +89,30 @@ def check_rotation(R: Any, name: str = "R", tol: float = GROUP_TOL) -> FloatArra
         return R
     err, det_err, k = rotation_errors(flat)
     if err > tol or det_err > tol:
-        where = (
-            f" at index {tuple(int(j) for j in np.unravel_index(k, R.shape[:-2]))}"
-            if R.ndim > 2
-            else ""
-        )
-        det = float(np.linalg.det(flat[k]))
-        raise NotOnGroupError(
-            f"{name} must be a rotation matrix (RᵀR = I to {tol:g}, det +1){where}; "
-            f"got max|RᵀR − I| = {err:.3g}, det = {det:.6g}"
-        )
+        raise _rotation_failure(name, tol, err, flat[k], R.shape[:-2], k)
     return R
 
 
 def check_se3(g: Any, name: str = "g", tol: float = GROUP_TOL) -> FloatArray:
     """Return ``g`` as an array of 4×4 SE(3) matrices, or raise :class:`NotOnGroupError`.
 
-    The rotation block must pass :func:`check_rotation` and the last row must be
-    ``[0, 0, 0, 1]`` to ``tol``.
+    The rotation block must be a rotation matrix (as :func:`check_rotation`) and the last
+    row ``[0, 0, 0, 1]``, both to ``tol``; one compiled pass checks both.
     """
+    from gmuk.lie._kernels import se3_errors
+
     g = as_array(g, (4, 4), name)
-    row_err = float(np.abs(g[..., 3, :] - _LAST_ROW).max(initial=0.0))
+    flat = np.ascontiguousarray(g.reshape(-1, 4, 4))
+    if flat.shape[0] == 0:
+        return g
+    row_err, err, det_err, k, _ = se3_errors(flat)
     if row_err > tol:
         raise NotOnGroupError(
             f"{name} must be a homogeneous transform with last row [0, 0, 0, 1]; "
             f"got a last row off by {row_err:.3g}"
         )
-    check_rotation(g[..., :3, :3], f"rotation block of {name}", tol)
+    if err > tol or det_err > tol:
+        raise _rotation_failure(
+            f"rotation block of {name}", tol, err, flat[k, :3, :3], g.shape[:-2], k
+        )
     return g

@@ -317,3 +317,49 @@ def rotation_errors(R: np.ndarray) -> tuple[float, float, int]:
         if eo + ed > worst_o + worst_d:
             worst_o, worst_d, idx = eo, ed, k
     return worst_o, worst_d, idx
+
+
+@njit(cache=True)
+def se3_errors(g: np.ndarray) -> tuple[float, float, float, int, int]:
+    """Over (n, 4, 4): worst last-row error and its index, worst ‖RᵀR − I‖_max and
+    |det R − 1| of the rotation blocks, and the index of the worst rotation block."""
+    worst_row = 0.0
+    k_row = 0
+    for k in range(g.shape[0]):
+        e = max(abs(g[k, 3, 0]), abs(g[k, 3, 1]), abs(g[k, 3, 2]), abs(g[k, 3, 3] - 1.0))
+        if e > worst_row:
+            worst_row, k_row = e, k
+    orth, det, k_rot = rotation_errors(g[:, :3, :3])
+    return worst_row, orth, det, k_rot, k_row
+
+
+@njit(cache=True)
+def se3_inverse(g: np.ndarray) -> np.ndarray:
+    """(n, 4, 4) → (n, 4, 4): [[Rᵀ, −Rᵀ r], [0, 1]]."""
+    out = np.zeros_like(g)
+    for k in range(g.shape[0]):
+        for i in range(3):
+            for j in range(3):
+                out[k, i, j] = g[k, j, i]
+            out[k, i, 3] = -(
+                g[k, 0, i] * g[k, 0, 3] + g[k, 1, i] * g[k, 1, 3] + g[k, 2, i] * g[k, 2, 3]
+            )
+        out[k, 3, 3] = 1.0
+    return out
+
+
+@njit(cache=True)
+def se3_Ad(g: np.ndarray) -> np.ndarray:
+    """(n, 4, 4) → (n, 6, 6): [[R, 0], [r^× R, R]] (McCann 2020, Eq. 16)."""
+    out = np.zeros((g.shape[0], 6, 6))
+    for k in range(g.shape[0]):
+        r0, r1, r2 = g[k, 0, 3], g[k, 1, 3], g[k, 2, 3]
+        for j in range(3):
+            c0, c1, c2 = g[k, 0, j], g[k, 1, j], g[k, 2, j]
+            out[k, 0, j] = out[k, 3, 3 + j] = c0
+            out[k, 1, j] = out[k, 4, 3 + j] = c1
+            out[k, 2, j] = out[k, 5, 3 + j] = c2
+            out[k, 3, j] = r1 * c2 - r2 * c1
+            out[k, 4, j] = r2 * c0 - r0 * c2
+            out[k, 5, j] = r0 * c1 - r1 * c0
+    return out

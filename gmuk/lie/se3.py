@@ -50,18 +50,6 @@ def _ad(V: FloatArray) -> FloatArray:
     return (V @ _AD_GEN_FLAT).reshape((*V.shape[:-1], 6, 6))
 
 
-def _homogeneous(R: FloatArray, r: FloatArray) -> FloatArray:
-    g = np.zeros((*R.shape[:-2], 4, 4))
-    g[..., :3, :3] = R
-    g[..., :3, 3] = r
-    g[..., 3, 3] = 1.0
-    return g
-
-
-def _matvec(M: FloatArray, x: FloatArray) -> FloatArray:
-    return (M @ x[..., None])[..., 0]
-
-
 def hat(V: Any) -> FloatArray:
     """Wedge map R⁶ → se(3): ``[ω; v] ↦ [[ω^×, v], [0, 0]]`` (McCann 2020, Eq. 12).
 
@@ -148,8 +136,8 @@ def log(g: Any) -> FloatArray:
 
 
 def _inverse(g: FloatArray) -> FloatArray:
-    Rt = np.swapaxes(g[..., :3, :3], -1, -2)
-    return _homogeneous(Rt, -_matvec(Rt, g[..., :3, 3]))
+    flat = np.ascontiguousarray(g.reshape(-1, 4, 4))
+    return _kernels.se3_inverse(flat).reshape(g.shape)
 
 
 def inverse(g: Any) -> FloatArray:
@@ -167,12 +155,8 @@ def inverse(g: Any) -> FloatArray:
 
 
 def _Ad(g: FloatArray) -> FloatArray:
-    R = g[..., :3, :3]
-    out = np.zeros((*g.shape[:-2], 6, 6))
-    out[..., :3, :3] = R
-    out[..., 3:, 3:] = R
-    out[..., 3:, :3] = _so3._hat(g[..., :3, 3]) @ R
-    return out
+    flat = np.ascontiguousarray(g.reshape(-1, 4, 4))
+    return _kernels.se3_Ad(flat).reshape((*g.shape[:-2], 6, 6))
 
 
 def Ad(g: Any) -> FloatArray:
