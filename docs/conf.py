@@ -26,7 +26,6 @@ autodoc_member_order = "bysource"
 autodoc_typehints = "description"
 autodoc_default_options = {"members": True, "show-inheritance": True}
 nitpicky = False
-suppress_warnings = ["autodoc.import_object"]
 exclude_patterns = ["_build"]
 html_theme = "alabaster"
 html_title = "gmuk"
