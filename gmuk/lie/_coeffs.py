@@ -1,4 +1,6 @@
-"""Scalar coefficient functions of the SO(3)/SE(3) closed forms, accurate for every angle.
+"""Series constants of the SO(3)/SE(3) coefficient functions, and a vectorised numpy reference
+for D, F₁ and F₂ (the compiled kernels in :mod:`gmuk.lie._kernels` are the implementation
+gmuk uses; these functions are the readable form the tests check them against).
 
 Each function takes an array of angles θ ≥ 0 (rad) and returns an array of the same shape.
 Where the closed form cancels catastrophically (θ → 0) a Taylor series in θ² is used below
@@ -67,24 +69,6 @@ def _split(
     """Return (small-mask, θ² for the series, θ clipped away from 0 for the closed form)."""
     small = theta < below
     return small, theta * theta, np.where(small, below, theta)
-
-
-def sinc(theta: FloatArray) -> FloatArray:
-    """sin θ / θ, with value 1 at θ = 0."""
-    return np.sinc(theta / np.pi)
-
-
-def one_minus_cos_over_sq(theta: FloatArray) -> FloatArray:
-    """B(θ) = (1 − cos θ)/θ² = ½ sinc²(θ/2), with value ½ at θ = 0 (no cancellation)."""
-    s = np.sinc(theta / (2.0 * np.pi))
-    return 0.5 * s * s
-
-
-def theta_minus_sin_over_cube(theta: FloatArray) -> FloatArray:
-    """C(θ) = (θ − sin θ)/θ³, with value 1/6 at θ = 0."""
-    small, t2, tc = _split(theta)
-    closed = (tc - np.sin(tc)) / (tc * tc * tc)
-    return np.where(small, np.polyval(_C_SERIES, t2), closed)
 
 
 def dexp_inv_d(theta: FloatArray) -> FloatArray:
