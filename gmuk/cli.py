@@ -26,7 +26,7 @@ DEFAULT_SCENARIO = "fcei"
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="gmuk", description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(prog="gmuk", description="List and run the thesis scenarios.")
     sub = p.add_subparsers(dest="command")
     sub.add_parser("list", help="list the scenarios with one-line descriptions")
     sub.add_parser("plugins", help="list the installed force models (gmuk's and plugins')")
