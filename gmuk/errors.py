@@ -10,6 +10,8 @@ from __future__ import annotations
 __all__ = [
     "ConstraintError",
     "DefinitionError",
+    "DegreeError",
+    "DomainError",
     "EulerSequenceError",
     "FileFormatError",
     "GmukError",
@@ -87,6 +89,15 @@ class SimulationError(GmukError, RuntimeError):
 class OrbitError(GmukError, ValueError):
     """Orbital elements or conic parameters are invalid or inconsistent (e < 0, a ≤ 0 for an
     ellipse, a with a parabola, a true anomaly beyond a hyperbola's asymptote, ...)."""
+
+
+class DegreeError(GmukError, ValueError):
+    """A spherical-harmonic degree or order is out of range (the message gives the range)."""
+
+
+class DomainError(GmukError, ValueError):
+    """A model was evaluated where it is not defined (a gravity field at its origin, or where
+    its series does not give a finite value)."""
 
 
 class GmukWarning(UserWarning):

@@ -1,0 +1,560 @@
+"""Compiled kernels of :mod:`gmuk.gravity` (numba, cached on disk).
+
+The formulation is described in the package docstring; this module holds the numerics only.
+
+Field data
+----------
+Everything one field needs at evaluation time lives in one read-only float64 vector, built
+once by :func:`field_data` (one array argument keeps the numba dispatch cost of a
+single-point call low). With ``N`` the degree and ``M = N + 2`` (the Hessian needs solid
+harmonics two degrees higher), its sections, in order, are
+
+======== ================= ===========================================================
+section  length            content
+======== ================= ===========================================================
+header   ``HEADER``        ``[N, μ, R, 0, ...]``
+C, S     ``L(N)`` each     ``C[n, m]``, ``S[n, m]``, packed column by column (``m``
+                           outer, ``n = m..N`` inner)
+A, B     ``L(M)`` each     recursion coefficients ``a_nm``, ``b_nm`` of the normalised
+                           column recursion, packed as above for degree ``M``; the
+                           entry ``n = m`` of ``A`` holds the sectoral factor ``k_m``
+f, F     ``M + 2`` each    ``f_n = √((2n+1)/(2n+3))`` and ``F_n = f_n f_{n+1}``
+h, G     ``2M + 8`` each   ``h_k = √k`` and ``G_k = √(k(k+1))``
+======== ================= ===========================================================
+
+with ``L(N) = (N+1)(N+2)/2``.
+
+Indices inside the loops are unsigned (``uint64``) so that no negative-index wraparound
+test is compiled into them (numba adds one for signed indices, which costs about a third
+of the time of these loops and prevents vectorisation).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, types, uint64
+
+from gmuk._validation import FloatArray
+
+__all__ = ["HEADER", "evaluate", "field_data", "offsets"]
+
+#: Length of the header of the field data vector.
+HEADER = 8
+
+#: Mantissa range of the extended-exponent ("X-number") arithmetic: values are kept as
+#: mantissa · BIG^e with the mantissa renormalised into [BIG⁻¹, BIG) when it leaves it.
+BIG = 2.0**480
+BIGI = 2.0**-480
+SQRT2 = math.sqrt(2.0)
+ISQRT2 = 1.0 / math.sqrt(2.0)
+
+#: Status codes returned by :func:`evaluate` (``code + 4 · index of the point``).
+OK = 0
+BAD_INPUT = 1
+AT_ORIGIN = 2
+BAD_OUTPUT = 3
+
+#: Reassociation lets LLVM vectorise the sums (their order changes, their accuracy does
+#: not: every term is of one sign-indefinite magnitude and the totals are compared with
+#: independent references to 1e-15 in the tests); "contract" allows fused multiply-adds.
+_SUMS = {"contract", "reassoc"}
+
+_RO = types.Array(types.float64, 1, "C", readonly=True)
+_RW = types.Array(types.float64, 1, "C")
+_RW2 = types.Array(types.float64, 2, "C")
+
+_U1 = np.uint64(1)
+_U2 = np.uint64(2)
+
+
+@njit(cache=True, inline="always")
+def _tri(n: int) -> int:
+    """Number of entries (n+1)(n+2)/2 of a lower triangle of degree n."""
+    return (n + 1) * (n + 2) // 2
+
+
+@njit(cache=True, inline="always")
+def _col(m: int, n: int) -> int:
+    """Offset of column m in a column-packed lower triangle of degree n."""
+    return m * (n + 1) - m * (m - 1) // 2
+
+
+def offsets(N: int) -> tuple[int, int, int, int, int, int, int, int, int]:
+    """Section offsets (C, S, A, B, f, F, h, G) and total length of a degree-N data vector."""
+    M = N + 2
+    L = (N + 1) * (N + 2) // 2
+    LM = (M + 1) * (M + 2) // 2
+    nh = 2 * M + 8
+    oC = HEADER
+    oS = oC + L
+    oA = oS + L
+    oB = oA + LM
+    of = oB + LM
+    oF = of + M + 2
+    oh = oF + M + 2
+    oG = oh + nh
+    return oC, oS, oA, oB, of, oF, oh, oG, oG + nh
+
+
+def field_data(mu: float, radius: float, C: FloatArray, S: FloatArray) -> FloatArray:
+    """Build the read-only data vector of a field (see the module docstring).
+
+    Parameters
+    ----------
+    mu : float
+        GM (m³/s²).
+    radius : float
+        Reference radius R (m).
+    C, S : ndarray, shape (N+1, N+1)
+        Fully normalised (4π) coefficients, lower triangular.
+
+    Returns
+    -------
+    ndarray, shape (n_data,)
+        Read-only.
+    """
+    N = C.shape[0] - 1
+    M = N + 2
+    oC, oS, oA, oB, of, oF, oh, oG, size = offsets(N)
+    d = np.zeros(size)
+    d[0], d[1], d[2] = N, mu, radius
+    rows, cols = np.tril_indices(N + 1)
+    order = np.lexsort((rows, cols))  # column by column, n increasing within a column
+    d[oC:oS] = C[rows[order], cols[order]]
+    d[oS:oA] = S[rows[order], cols[order]]
+    # Recursion coefficients of the normalised column recursion (Holmes & Featherstone
+    # 2002, Eqs. 11-12), for degree M; ratios of small integers, no factorials.
+    rows, cols = np.tril_indices(M + 1)
+    order = np.lexsort((rows, cols))
+    n = rows[order].astype(float)
+    m = cols[order].astype(float)
+    a = np.empty_like(n)
+    b = np.zeros_like(n)
+    diag = n == m
+    sub = ~diag
+    a[sub] = np.sqrt((2 * n[sub] - 1) * (2 * n[sub] + 1) / ((n[sub] - m[sub]) * (n[sub] + m[sub])))
+    far = n >= m + 2
+    b[far] = np.sqrt(
+        (2 * n[far] + 1)
+        * (n[far] + m[far] - 1)
+        * (n[far] - m[far] - 1)
+        / ((n[far] - m[far]) * (n[far] + m[far]) * (2 * n[far] - 3))
+    )
+    md = m[diag]
+    sectoral = np.sqrt((2 * md + 1) / (2 * np.maximum(md, 1.0)))  # k_m, m >= 2
+    sectoral[md == 1] = math.sqrt(3.0)
+    sectoral[md == 0] = 1.0
+    a[diag] = sectoral
+    d[oA:oB] = a
+    d[oB:of] = b
+    k = np.arange(M + 2, dtype=float)
+    f = np.sqrt((2 * k + 1) / (2 * k + 3))
+    d[of:oF] = f
+    d[oF : oF + M + 1] = f[:-1] * f[1:]
+    k = np.arange(oG - oh, dtype=float)
+    d[oh:oG] = np.sqrt(k)
+    d[oG:size] = np.sqrt(k * (k + 1))
+    d.setflags(write=False)
+    return d
+
+
+@njit(cache=True, fastmath={"contract"})
+def _q_column(d, oa, ob, j, M, rhou, rho2, Q, qo):  # type: ignore[no-untyped-def]
+    """Real part q_n, n = j..M, of solid-harmonic column j, with q_j = 1.
+
+    ``Φ̄_nj = σ_j q_n`` where σ_j is the column's complex seed. Values are scaled by
+    BIG⁻¹ whenever one exceeds BIG (rare: high degree near the poles); the number of
+    scalings is returned so that the caller can fold BIG^e into σ_j.
+    """
+    e = 0
+    base_a = uint64(oa)
+    base_b = uint64(ob)
+    base_q = uint64(qo + j)
+    Q[base_q] = 1.0
+    p1 = 1.0
+    p2 = 0.0
+    for i in range(1, M - j + 1):
+        k = uint64(i)
+        c = (d[base_a + k] * rhou) * p1 - (d[base_b + k] * rho2) * p2
+        Q[base_q + k] = c
+        p2 = p1
+        p1 = c
+        if abs(c) > BIG:
+            for i2 in range(i + 1):
+                Q[base_q + uint64(i2)] *= BIGI
+            p1 *= BIGI
+            p2 *= BIGI
+            e += 1
+    return e
+
+
+@njit(cache=True, fastmath=_SUMS)
+def _potential_sums(d, oc, os_, Q, q0, L):  # type: ignore[no-untyped-def]
+    """Σ C q and Σ S q along one column (potential)."""
+    uc = 0.0
+    us = 0.0
+    bc = uint64(oc)
+    bs = uint64(os_)
+    b0 = uint64(q0)
+    for i in range(L):
+        k = uint64(i)
+        q = Q[b0 + k]
+        uc += d[bc + k] * q
+        us += d[bs + k] * q
+    return uc, us
+
+
+@njit(cache=True, fastmath=_SUMS)
+def _gradient_sums(d, oc, os_, of, oha, ohb, oga, ogb, Q, q0, qp, qm, L):  # type: ignore[no-untyped-def]
+    """Weighted sums of one coefficient column against solid-harmonic columns m, m±1."""
+    zc = 0.0
+    zs = 0.0
+    pc = 0.0
+    ps = 0.0
+    mc = 0.0
+    ms = 0.0
+    bc = uint64(oc)
+    bs = uint64(os_)
+    bf = uint64(of)
+    bha = uint64(oha)
+    bhb = uint64(ohb)
+    bga = uint64(oga)
+    bgb = uint64(ogb)
+    b0 = uint64(q0)
+    bp = uint64(qp)
+    bm = uint64(qm)
+    for i in range(L):
+        k = uint64(i)
+        c = d[bc + k]
+        s = d[bs + k]
+        fn = d[bf + k]
+        t = fn * d[bha + k] * d[bhb + k] * Q[b0 + k]
+        zc += t * c
+        zs += t * s
+        t = fn * d[bga + k] * Q[bp + k]
+        pc += t * c
+        ps += t * s
+        t = fn * d[bgb + k] * Q[bm + k]
+        mc += t * c
+        ms += t * s
+    return zc, zs, pc, ps, mc, ms
+
+
+@njit(cache=True, fastmath=_SUMS)
+def _hessian_sums(d, oc, os_, oF, oha, ohb, oga, ogb, Q, q0, qp, qpp, qm, qmm, L):  # type: ignore[no-untyped-def]
+    """Weighted sums of one coefficient column against solid-harmonic columns m, m±1, m±2."""
+    xc = 0.0
+    xs = 0.0
+    yc = 0.0
+    ys = 0.0
+    zc = 0.0
+    zs = 0.0
+    uc = 0.0
+    us = 0.0
+    vc = 0.0
+    vs = 0.0
+    bc = uint64(oc)
+    bs = uint64(os_)
+    bF = uint64(oF)
+    bha = uint64(oha)
+    bhb = uint64(ohb)
+    bga = uint64(oga)
+    bgb = uint64(ogb)
+    b0 = uint64(q0)
+    bp = uint64(qp)
+    bpp = uint64(qpp)
+    bm = uint64(qm)
+    bmm = uint64(qmm)
+    for i in range(L):
+        k = uint64(i)
+        w = d[bF + k]
+        c = d[bc + k] * w
+        s = d[bs + k] * w
+        ab = d[bha + k] * d[bhb + k]
+        ga1 = d[bga + k]
+        gb1 = d[bgb + k]
+        t = ga1 * d[bga + k + _U2] * Q[bpp + k]
+        xc += t * c
+        xs += t * s
+        t = ab * d[bga + k + _U1] * Q[bp + k]
+        yc += t * c
+        ys += t * s
+        t = ga1 * gb1 * Q[b0 + k]
+        zc += t * c
+        zs += t * s
+        t = ab * d[bgb + k + _U1] * Q[bm + k]
+        uc += t * c
+        us += t * s
+        t = gb1 * d[bgb + k + _U2] * Q[bmm + k]
+        vc += t * c
+        vs += t * s
+    return xc, xs, yc, ys, zc, zs, uc, us, vc, vs
+
+
+# One explicit signature: positions typed read-only accept writable arrays as well, so a
+# read-only input never triggers a second compilation. Compiled (or loaded from numba's
+# on-disk cache) when this module is imported.
+@njit(types.int64(_RO, _RO, _RW, _RW2, types.int64), cache=True)
+def evaluate(d, r, out, hess, mode):  # type: ignore[no-untyped-def]
+    """Potential, gradient and/or Hessian of a field at points (see the package docstring).
+
+    Parameters
+    ----------
+    d : ndarray, shape (n_data,)
+        Field data from :func:`field_data`.
+    r : ndarray, shape (3k,)
+        Body-fixed positions (m), point after point.
+    out : ndarray, shape (k · stride,)
+        Written per point, in order: U (1, if bit 1 of ``mode``) and ∇U (3, bit 2);
+        ``stride`` is the number of values requested (may be empty if neither is).
+    hess : ndarray, shape (3k, 3)
+        The Hessian of point i in rows 3i..3i+2 (bit 4; may be empty otherwise).
+    mode : int
+        Bits: 1 potential, 2 gradient, 4 Hessian, 8 leave out the central term C00 μ/r.
+
+    Returns
+    -------
+    int
+        0, or ``code + 4 i`` for the first failing point i: code 1 non-finite input,
+        2 point at the origin, 3 non-finite result.
+    """
+    N = int(d[0])
+    mu = d[1]
+    R = d[2]
+    want_u = (mode & 1) != 0
+    want_a = (mode & 2) != 0
+    want_h = (mode & 4) != 0
+    skip0 = (mode & 8) != 0
+    lead = 2 if want_h else (1 if want_a else 0)
+    M = N + 2
+    Mc = N + lead  # highest degree of solid harmonic needed
+    L = _tri(N)
+    LM = _tri(M)
+    oC = HEADER
+    oS = oC + L
+    oA = oS + L
+    oB = oA + LM
+    of = oB + LM
+    oF = of + M + 2
+    oh = oF + M + 2
+    oG = oh + 2 * M + 8
+    stride = (1 if want_u else 0) + (3 if want_a else 0)
+    npts = r.shape[0] // 3
+    W = Mc + 1
+    Q = np.empty(8 * W)
+    sig_r = np.zeros(8)
+    sig_i = np.zeros(8)
+    for ip in range(npts):
+        x = r[3 * ip]
+        y = r[3 * ip + 1]
+        z = r[3 * ip + 2]
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            return BAD_INPUT + 4 * ip
+        rn = math.sqrt(x * x + y * y + z * z)
+        if rn == 0.0:
+            return AT_ORIGIN + 4 * ip
+        rho = R / rn
+        s = x / rn
+        t = y / rn
+        rhou = rho * z / rn
+        rho2 = rho * rho
+        # seed σ_j of solid-harmonic column j: mantissa (sr, si) times BIG^se
+        sr = rho
+        si = 0.0
+        se = 0
+        zero_from = Mc + 1  # columns from here on are identically zero (x = y = 0)
+        done = -1
+        pot = 0.0
+        gpr = 0.0
+        gpi = 0.0
+        gmr = 0.0
+        gmi = 0.0
+        gz = 0.0
+        hppr = 0.0
+        hppi = 0.0
+        hmmr = 0.0
+        hmmi = 0.0
+        hzz = 0.0
+        hpzr = 0.0
+        hpzi = 0.0
+        hmzr = 0.0
+        hmzi = 0.0
+        for m in range(N + 1):
+            if m - lead >= zero_from:
+                break
+            # solid-harmonic columns m - 2 .. m + lead must be available
+            while done < m + lead:
+                j = done + 1
+                slot = j & 7
+                qo = slot * W
+                if j > 0 and j < zero_from:
+                    kj = d[oA + _col(j, M)]
+                    fr = kj * rho * s
+                    fi = kj * rho * t
+                    nr = fr * sr - fi * si
+                    si = fr * si + fi * sr
+                    sr = nr
+                    mag = max(abs(sr), abs(si))
+                    if mag == 0.0:
+                        zero_from = j
+                    else:
+                        while mag < BIGI:
+                            sr *= BIG
+                            si *= BIG
+                            mag *= BIG
+                            se -= 1
+                        while se < 0 and mag >= 1.0:
+                            sr *= BIGI
+                            si *= BIGI
+                            mag *= BIGI
+                            se += 1
+                if j < zero_from:
+                    oa = oA + _col(j, M)
+                    ob = oB + _col(j, M)
+                    e = se + _q_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo)
+                    er = sr
+                    ei = si
+                    while e > 0:
+                        er *= BIG
+                        ei *= BIG
+                        e -= 1
+                    while e < 0:
+                        er *= BIGI
+                        ei *= BIGI
+                        e += 1
+                    sig_r[slot] = er
+                    sig_i[slot] = ei
+                else:
+                    for k in range(j, Mc + 1):
+                        Q[qo + k] = 0.0
+                    sig_r[slot] = 0.0
+                    sig_i[slot] = 0.0
+                done = j
+            n0 = 1 if (skip0 and m == 0) else m
+            Lm = N + 1 - n0
+            if Lm <= 0:
+                continue
+            cofs = _col(m, N) + n0 - m
+            q0 = (m & 7) * W
+            qp = ((m + 1) & 7) * W
+            qm = ((m - 1) & 7) * W if m >= 1 else qp
+            s0r = sig_r[m & 7]
+            s0i = sig_i[m & 7]
+            spr = sig_r[(m + 1) & 7]
+            spi = sig_i[(m + 1) & 7]
+            if want_u:
+                uc, us = _potential_sums(d, oC + cofs, oS + cofs, Q, q0 + n0, Lm)
+                pot += uc * s0r + us * s0i
+            if want_a:
+                k1 = n0 + 1
+                zc, zs, pc, ps, mc, ms = _gradient_sums(
+                    d, oC + cofs, oS + cofs, of + n0,
+                    oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
+                    Q, q0 + k1, qp + k1, qm + k1, Lm,
+                )  # fmt: skip
+                gz += zc * s0r + zs * s0i
+                if m == 0:
+                    pc *= ISQRT2
+                    gpr += pc * spr
+                    gpi += pc * spi
+                    gmr -= pc * spr
+                    gmi += pc * spi
+                else:
+                    gpr += pc * spr + ps * spi
+                    gpi += pc * spi - ps * spr
+                    if m == 1:
+                        mc *= SQRT2
+                        ms *= SQRT2
+                    smr = sig_r[(m - 1) & 7]
+                    smi = sig_i[(m - 1) & 7]
+                    gmr += mc * smr + ms * smi
+                    gmi += mc * smi - ms * smr
+            if want_h:
+                k2 = n0 + 2
+                qpp = ((m + 2) & 7) * W
+                qmm = ((m - 2) & 7) * W if m >= 2 else qp
+                xc, xs, yc, ys, zc, zs, uc, us, vc, vs = _hessian_sums(
+                    d, oC + cofs, oS + cofs, oF + n0,
+                    oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
+                    Q, q0 + k2, qp + k2, qpp + k2, qm + k2, qmm + k2, Lm,
+                )  # fmt: skip
+                sppr = sig_r[(m + 2) & 7]
+                sppi = sig_i[(m + 2) & 7]
+                hzz += zc * s0r + zs * s0i
+                if m == 0:
+                    # S[n, 0] = 0; the lowering operator acts on the conjugate
+                    xc *= ISQRT2
+                    yc *= ISQRT2
+                    hppr += xc * sppr
+                    hppi += xc * sppi
+                    hpzr += yc * spr
+                    hpzi += yc * spi
+                    hmzr += yc * spr
+                    hmzi -= yc * spi
+                    hmmr += xc * sppr
+                    hmmi -= xc * sppi
+                else:
+                    hppr += xc * sppr + xs * sppi
+                    hppi += xc * sppi - xs * sppr
+                    hpzr += yc * spr + ys * spi
+                    hpzi += yc * spi - ys * spr
+                    smr = sig_r[(m - 1) & 7]
+                    smi = sig_i[(m - 1) & 7]
+                    if m == 1:
+                        uc *= SQRT2
+                        us *= SQRT2
+                        # lowering twice from order 1 lands on the conjugate of order 1
+                        hmmr -= zc * s0r - zs * s0i
+                        hmmi += zc * s0i + zs * s0r
+                    else:
+                        if m == 2:
+                            vc *= SQRT2
+                            vs *= SQRT2
+                        smmr = sig_r[(m - 2) & 7]
+                        smmi = sig_i[(m - 2) & 7]
+                        hmmr += vc * smmr + vs * smmi
+                        hmmi += vc * smmi - vs * smmr
+                    hmzr -= uc * smr + us * smi
+                    hmzi -= uc * smi - us * smr
+        o = ip * stride
+        if want_u:
+            out[o] = (mu / R) * pot
+            if not math.isfinite(out[o]):
+                return BAD_OUTPUT + 4 * ip
+            o += 1
+        if want_a:
+            k_ = 0.5 * mu / (R * R)
+            out[o] = k_ * (gmr - gpr)
+            out[o + 1] = -k_ * (gpi + gmi)
+            out[o + 2] = -2.0 * k_ * gz
+            if not (
+                math.isfinite(out[o]) and math.isfinite(out[o + 1]) and math.isfinite(out[o + 2])
+            ):
+                return BAD_OUTPUT + 4 * ip
+            o += 3
+        if want_h:
+            k_ = mu / (R * R * R)
+            hxx = 0.25 * k_ * (hppr + hmmr - 2.0 * hzz)
+            hyy = -0.25 * k_ * (hppr + hmmr + 2.0 * hzz)
+            hxy = 0.25 * k_ * (hppi - hmmi)
+            hxz = 0.5 * k_ * (hpzr + hmzr)
+            hyz = 0.5 * k_ * (hpzi - hmzi)
+            hz = k_ * hzz
+            h0 = 3 * ip
+            hess[h0, 0] = hxx
+            hess[h0, 1] = hxy
+            hess[h0, 2] = hxz
+            hess[h0 + 1, 0] = hxy
+            hess[h0 + 1, 1] = hyy
+            hess[h0 + 1, 2] = hyz
+            hess[h0 + 2, 0] = hxz
+            hess[h0 + 2, 1] = hyz
+            hess[h0 + 2, 2] = hz
+            if not (
+                math.isfinite(hxx) and math.isfinite(hyy) and math.isfinite(hz)
+                and math.isfinite(hxy) and math.isfinite(hxz) and math.isfinite(hyz)
+            ):  # fmt: skip
+                return BAD_OUTPUT + 4 * ip
+    return OK
