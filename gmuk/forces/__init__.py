@@ -3,6 +3,7 @@
 from gmuk.forces.base import ForceModel
 from gmuk.forces.gravity import GravityGradient, PointMassGravity, SphericalHarmonicGravity
 from gmuk.forces.mechanical import AppliedWrench, SpringDamper, UniformGravity
+from gmuk.forces.thesis_gravity import ThesisRadialHarmonicGravity
 
 __all__ = [
     "AppliedWrench",
@@ -11,5 +12,6 @@ __all__ = [
     "PointMassGravity",
     "SphericalHarmonicGravity",
     "SpringDamper",
+    "ThesisRadialHarmonicGravity",
     "UniformGravity",
 ]
