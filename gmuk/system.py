@@ -24,7 +24,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from gmuk import _uk_kernels, uk
-from gmuk._validation import FloatArray, as_array, check_se3
+from gmuk._validation import FloatArray, all_finite, as_array, check_se3
 from gmuk.bodies import Body, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
 from gmuk.constraints.relative import RelativeConstraint
@@ -32,6 +32,7 @@ from gmuk.constraints.tangent_bundle import TangentBundleConstraint
 from gmuk.constraints.tracking import ConfigurationTracking
 from gmuk.control.base import Controller
 from gmuk.errors import (
+    ConstraintError,
     DefinitionError,
     InconsistentConstraintsError,
     InconsistentConstraintsWarning,
@@ -47,6 +48,10 @@ __all__ = ["Accelerations", "System"]
 
 #: Above this many degrees of freedom (or constraint rows), "auto" selects the sparse path.
 SPARSE_THRESHOLD = 300
+#: Dense path: up to this many rows, full-row-rank A is solved by Householder QR (compiled,
+#: no LAPACK set-up) when its condition number is certified ≤ QR_COND_LIMIT; else by SVD.
+QR_MAX_ROWS = 48
+QR_COND_LIMIT = 1e8
 _EPS = float(np.finfo(float).eps)
 
 
@@ -95,6 +100,14 @@ class Accelerations:
     rank: int | None
     unreachable: float
     z_dot: FloatArray
+
+    @classmethod
+    def _make(cls, **fields: Any) -> Accelerations:
+        # The frozen dataclass's __init__ sets 13 fields through object.__setattr__, a
+        # measurable share of a one-body call; the System passes every field, by name.
+        obj = object.__new__(cls)
+        obj.__dict__.update(fields)
+        return obj
 
     def of(self, body: Body | str, field: str = "total") -> FloatArray:
         """The slice of a per-dof field (e.g. "total", "constraint_force") for one body."""
@@ -194,6 +207,17 @@ class System:
         self._build_mass()
         self._build_index()
         self.tangent_bundle = any(isinstance(c, TangentBundleConstraint) for c in self.constraints)
+        # Whether anything acts on the plant that the UK solve does not see.
+        self._plant_only_loads = bool(self.controllers) or any(not f.modeled for f in self.forces)
+        # Small dense all-rigid R⁶ systems: free accelerations, QR solve and packing in one
+        # compiled call (uk_rigid); anything else, or a rank it cannot certify, takes the
+        # general path.
+        self._zero_loads = np.zeros(self.layout.n_dof)
+        self._zero_loads.setflags(write=False)
+        self._single_dense = self._single_full_width and not (self.sparse or self.tangent_bundle)
+        self._fused = not (
+            self.sparse or self.tangent_bundle or self._plant_only_loads or self.layout.n_euclid
+        ) and bool(self.constraints)
 
     # ------------------------------------------------------------------ validation
     def _validate(self) -> list[str]:
@@ -437,6 +461,10 @@ class System:
 
     def _free(self, state: State, Q: FloatArray) -> FloatArray:
         """ν̇_a = M⁻¹(ad*_V 𝕀V + Q) (Eq. 10b for rigid bodies, Q/m for the others)."""
+        if not self.layout.n_euclid:  # rigid bodies only: ν is the stacked twists
+            return _uk_kernels.rigid_free_accel(
+                state.V, self._J, self._Jinv, self._m_rigid, Q.reshape(-1, 6)
+            ).reshape(-1)
         a = np.empty(self.layout.n_dof)
         if self.layout.n_rigid:
             a[self._rigid_idx] = _uk_kernels.rigid_free_accel(
@@ -450,6 +478,8 @@ class System:
     def _generalized_forces(
         self, state: State
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        if not (self.forces or self.controllers):  # shared, read-only zeros
+            return self._zero_loads, self._zero_loads, self._zero_loads, self._zero_loads[:0]
         n = self.layout.n_dof
         modeled, unmodeled, control = np.zeros(n), np.zeros(n), np.zeros(n)
         for f, bodies in zip(self.forces, self._force_bodies, strict=True):
@@ -478,10 +508,42 @@ class System:
     def constraint_rows(self, state: State) -> tuple[FloatArray | sp.csr_matrix, FloatArray]:
         """The stacked rows (A (s, n_dof), b (s,)) of all R⁶ constraints at ``state``
         (a sparse CSR A on the sparse path)."""
+        return self._stack_rows(state, check_finite=True)
+
+    def _stack_rows(
+        self, state: State, check_finite: bool
+    ) -> tuple[FloatArray | sp.csr_matrix, FloatArray]:
+        """Stacked rows; with ``check_finite=False`` float64 ndarrays of the right shapes are
+        taken as they are and the caller checks finiteness of the stacked A and b (then
+        :meth:`constraint_rows` names the culprit)."""
+        if self._single_dense and not check_finite:
+            # The common small case: one dense constraint on every dof, in order.
+            Ai, bi = self.constraints[0].rows(state)
+            if (
+                type(Ai) is np.ndarray
+                and type(bi) is np.ndarray
+                and Ai.dtype == np.float64
+                and bi.dtype == np.float64
+                and bi.ndim == 1
+                and Ai.shape == (bi.shape[0], self.layout.n_dof)
+            ):
+                return Ai, bi
+            Ai, bi = as_rows(Ai, bi, self.layout.n_dof, f"constraint {self.constraints[0].name!r}")
+            return (Ai.toarray() if sp.issparse(Ai) else Ai), bi
         blocks = []
         for c, cols in zip(self.constraints, self._constraint_cols, strict=True):
             Ai, bi = c.rows(state)
-            blocks.append((*as_rows(Ai, bi, cols.size, f"constraint {c.name!r}"), cols))
+            if not (
+                not check_finite
+                and type(Ai) is np.ndarray
+                and type(bi) is np.ndarray
+                and Ai.dtype == np.float64
+                and bi.dtype == np.float64
+                and bi.ndim == 1
+                and Ai.shape == (bi.shape[0], cols.size)
+            ):
+                Ai, bi = as_rows(Ai, bi, cols.size, f"constraint {c.name!r}")
+            blocks.append((Ai, bi, cols))
         n = self.layout.n_dof
         s = sum(bi.size for _, bi, _ in blocks)
         b = np.concatenate([bi for _, bi, _ in blocks]) if blocks else np.zeros(0)
@@ -530,33 +592,80 @@ class System:
         if state.layout is not self.layout and state.layout != self.layout:
             raise DefinitionError("state belongs to another System (layouts differ)")
         modeled, unmodeled, control, z_dot = self._generalized_forces(state)
+        rows = None
+        if self._fused:
+            rows = A, b = self._stack_rows(state, check_finite=False)
+            if 0 < b.size <= QR_MAX_ROWS:
+                rcond = self.rcond if self.rcond is not None else max(A.shape) * _EPS
+                out = _uk_kernels.uk_rigid(
+                    state.V,
+                    modeled,
+                    A,
+                    b,
+                    self._J,
+                    self._Jinv,
+                    self._m_rigid,
+                    self._Minv_sqrt,
+                    self._M_dense,
+                    min(QR_COND_LIMIT, 0.1 / rcond),
+                    self.consistency_tol,
+                )
+                n, s = A.shape[1], b.size
+                status = out[-1]
+                if status == 3.0:
+                    self._check_consistency(state, float(out[-3]), float(out[-2]))
+                if status == 0.0 or status == 3.0:  # certified full row rank: solved
+                    return Accelerations._make(
+                        layout=self.layout,
+                        free=out[:n],
+                        constraint=out[n : 2 * n],
+                        extra=self._zero_loads,  # no plant-only loads in a fused System
+                        total=out[2 * n : 3 * n],
+                        constraint_force=out[3 * n : 4 * n],
+                        control_force=control,
+                        unmodeled_force=unmodeled,
+                        multipliers=out[4 * n : 4 * n + s],
+                        residual=float(out[-3]),
+                        rank=s,
+                        unreachable=0.0,
+                        z_dot=z_dot,
+                    )
         a = self._free(state, modeled)
-        extra = self._apply_Minv(unmodeled + control)
+        if self._plant_only_loads:
+            extra = self._apply_Minv(unmodeled + control)
+            total = a + extra
+        else:
+            extra = np.zeros_like(a)
+            total = a.copy()
         unreachable = 0.0
         if self.tangent_bundle:
             ac, lam, rank, residual, unreachable = self._solve_t2(state, a)
         else:
-            ac, lam, rank, residual = self._solve_r6(state, a)
-        return Accelerations(
-            self.layout,
-            a,
-            ac,
-            extra,
-            a + ac + extra,
-            self._apply_M(ac),
-            control,
-            unmodeled,
-            lam,
-            residual,
-            rank,
-            unreachable,
-            z_dot,
+            ac, lam, rank, residual = self._solve_r6(state, a, rows)
+        total += ac
+        return Accelerations._make(
+            layout=self.layout,
+            free=a,
+            constraint=ac,
+            extra=extra,
+            total=total,
+            constraint_force=self._apply_M(ac),
+            control_force=control,
+            unmodeled_force=unmodeled,
+            multipliers=lam,
+            residual=residual,
+            rank=rank,
+            unreachable=unreachable,
+            z_dot=z_dot,
         )
 
     def _solve_r6(
-        self, state: State, a: FloatArray
+        self, state: State, a: FloatArray, rows: tuple[Any, FloatArray] | None = None
     ) -> tuple[FloatArray, FloatArray, int | None, float]:
-        A, b = self.constraint_rows(state)
+        A, b = self._stack_rows(state, check_finite=False) if rows is None else rows
+        if not (all_finite((A.data if sp.issparse(A) else A).reshape(-1)) and all_finite(b)):
+            self.constraint_rows(state)  # raises ConstraintError naming the constraint
+            raise ConstraintError(f"constraint rows at t = {state.t:.9g} s are not finite")
         return self._solve_rows(state, a, A, b)
 
     def _solve_rows(
@@ -565,6 +674,7 @@ class System:
         """UK solve of given rows, with the consistency check."""
         if b.size == 0:
             return np.zeros_like(a), np.zeros(0), 0, 0.0
+        status = 1
         if self.sparse:
             Aa = A @ a
             ac, lam, rank = uk.solve_sparse(
@@ -574,8 +684,25 @@ class System:
             norm_Aa = float(np.linalg.norm(Aa))
         else:
             rcond = self.rcond if self.rcond is not None else max(A.shape) * _EPS
-            ac, lam, rank, residual, norm_Aa = _uk_kernels.uk_dense(A, b, a, self._Minv_sqrt, rcond)
-        scale = max(1.0, float(np.sqrt(b @ b)), norm_Aa)
+            # Full row rank certified (κ(A M^{-1/2}) ≤ QR_COND_LIMIT): the QR solve gives the
+            # same ν̇_c and λ as the SVD for a fraction of the cost; otherwise the SVD.
+            status = 1
+            if A.shape[0] <= QR_MAX_ROWS:
+                ac, lam, residual, scale, status = _uk_kernels.uk_qr(
+                    A, b, a, self._Minv_sqrt, min(QR_COND_LIMIT, 0.1 / rcond)
+                )
+                rank = b.size
+            if status != 0:
+                ac, lam, rank, residual, norm_Aa = _uk_kernels.uk_dense(
+                    A, b, a, self._Minv_sqrt, rcond
+                )
+        if status != 0:
+            scale = max(1.0, float(np.sqrt(b @ b)), norm_Aa)
+        self._check_consistency(state, residual, scale)
+        return ac, lam, rank, residual
+
+    def _check_consistency(self, state: State, residual: float, scale: float) -> None:
+        """Warn (raise in strict mode) when ‖A ν̇ − b‖ exceeds consistency_tol × scale."""
         if residual > self.consistency_tol * scale:
             msg = (
                 f"constraints are inconsistent at t = {state.t:.9g} s: ‖A ν̇ − b‖ = "
@@ -585,7 +712,6 @@ class System:
             if self.strict:
                 raise InconsistentConstraintsError(msg)
             warnings.warn(msg, InconsistentConstraintsWarning, stacklevel=3)
-        return ac, lam, rank, residual
 
     def _solve_t2(
         self, state: State, a: FloatArray

@@ -17,7 +17,7 @@ import numpy as np
 from gmuk import _uk_kernels
 from gmuk._validation import FloatArray
 from gmuk.constraints.base import Baumgarte, Constraint
-from gmuk.errors import DefinitionError
+from gmuk.errors import ConstraintError, DefinitionError
 from gmuk.lie import se3
 from gmuk.reference import ReferenceTrajectory
 
@@ -97,13 +97,15 @@ class ConfigurationTracking(Constraint):
         (body,) = self.bodies
         g, V = state.pose(body), state.twist(body)
         ref = self.reference.evaluate(state.t)
-        b = _uk_kernels.tracking_b(
-            g,
-            V,
-            np.asarray(ref.g, dtype=float),
-            np.asarray(ref.V, dtype=float),
-            np.asarray(ref.V_dot, dtype=float),
-        )
+        gd = np.asarray(ref.g, dtype=np.float64)
+        Vd = np.asarray(ref.V, dtype=np.float64)
+        Vd_dot = np.asarray(ref.V_dot, dtype=np.float64)
+        if gd.shape != (4, 4) or Vd.shape != (6,) or Vd_dot.shape != (6,):
+            raise ConstraintError(
+                f"constraint {self.name!r}: the reference returned g {gd.shape}, V {Vd.shape}, "
+                f"V_dot {Vd_dot.shape}; expected (4, 4), (6,), (6,)"
+            )
+        b = _uk_kernels.tracking_b(g, V, gd, Vd, Vd_dot)
         if self.baumgarte is not None:
             e_g, e_V = tracking_errors(g, V, ref.g, ref.V)
             b = b - self.baumgarte.alpha * e_V - self.baumgarte.beta * e_g

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray, as_array, check_se3
+from gmuk._validation import FloatArray, all_finite, as_array, check_se3
 from gmuk.errors import NotOnGroupError
 from gmuk.lie import _kernels
 from gmuk.lie import so3 as _so3
@@ -110,6 +110,9 @@ def exp(xi: Any) -> FloatArray:
         ``[[exp(θ^×), Jₗ(θ) ρ], [0, 1]]`` with the SO(3) left Jacobian
         ``Jₗ = I + ((1 − cos θ)/θ²) θ^× + ((θ − sin θ)/θ³) (θ^×)²`` (series below θ = 1).
     """
+    if type(xi) is np.ndarray and xi.shape == (6,) and xi.dtype == np.float64:
+        if all_finite(xi):  # one element, the common case: no reshaping round trip
+            return _kernels.se3_exp(xi.reshape(1, 6))[0]
     return _exp(as_array(xi, (6,), "xi"))
 
 

@@ -1,0 +1,144 @@
+"""The compiled small-system path of System.accelerations (QR solve, one fused call) gives the
+same numbers as the general SVD path, certifies rank before trusting itself, and keeps
+every input check of the general path."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers import Rows, ScrewReference, random_rigid_bodies, random_state
+
+import gmuk
+from gmuk import _uk_kernels
+from gmuk.errors import ConstraintError
+from gmuk.reference import ReferenceState, ReferenceTrajectory
+
+EPS = np.finfo(float).eps
+
+
+def _spd_inverse_sqrt(rng, n):
+    L = rng.normal(size=(n, n))
+    w, Q = np.linalg.eigh(L @ L.T + n * np.eye(n))
+    return Q @ np.diag(w**-0.5) @ Q.T
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_qr_solve_equals_the_svd_solve_within_the_conditioning(seed):
+    rng = np.random.default_rng(seed)
+    declined = 0
+    for _ in range(200):
+        n = int(rng.integers(1, 19))
+        s = int(rng.integers(1, n + 1))
+        # Rows scaled over six decades: condition numbers up to ~1e6.
+        A = rng.normal(size=(s, n)) * 10.0 ** rng.uniform(-3, 3, size=(s, 1))
+        b, a = rng.normal(size=s), rng.normal(size=n)
+        Ms = _spd_inverse_sqrt(rng, n)
+        ac_svd, lam_svd, rank, _, _ = _uk_kernels.uk_dense(A, b, a, Ms, n * EPS)
+        ac, lam, res, scale, status = _uk_kernels.uk_qr(A, b, a, Ms, 1e8)
+        assert rank == s
+        kappa = np.linalg.cond(A @ Ms)
+        if status == 1:  # the certificate √s‖R⁻¹‖₁‖R‖_F is at most s^1.5 κ
+            assert s**1.5 * kappa > 1e8
+            declined += 1
+            continue
+        assert status == 0
+        assert np.abs(ac - ac_svd).max() <= 50 * EPS * kappa * np.abs(ac_svd).max()
+        assert np.abs(lam - lam_svd).max() <= 50 * EPS * kappa**2 * np.abs(lam_svd).max()
+        assert res <= 50 * EPS * kappa * max(np.abs(b).max(), np.abs(A @ a).max())
+        expected = max(1.0, np.linalg.norm(b), np.linalg.norm(A @ a))
+        assert abs(scale - expected) <= 1e-12 * expected
+    assert declined <= 10  # the SVD is the exception, not the rule
+
+
+def test_qr_solve_declines_what_it_cannot_certify():
+    I6 = np.eye(6)
+    ones = np.ones(6)
+    redundant = np.vstack([I6[:3], I6[:1]])  # rank 3 < 4 rows
+    assert _uk_kernels.uk_qr(redundant, np.ones(4), ones, I6, 1e8)[4] == 1
+    near = I6.copy()
+    near[5] = near[4] * (1.0 + 1e-12)  # κ ≈ 1e12 > limit
+    assert _uk_kernels.uk_qr(near, ones, ones, I6, 1e8)[4] == 1
+    wide = np.vstack([I6, I6[:1]])  # more rows than dof
+    assert _uk_kernels.uk_qr(wide, np.ones(7), ones, I6, 1e8)[4] == 1
+    bad = I6.copy()
+    bad[2, 3] = np.nan
+    assert _uk_kernels.uk_qr(bad, ones, ones, I6, 1e8)[4] == 2
+    assert _uk_kernels.uk_qr(I6, np.r_[ones[:5], np.inf], ones, I6, 1e8)[4] == 2
+
+
+def _general_path(system):
+    """The same System with the fused call switched off (the SVD path of every version)."""
+    system._fused = False
+    return system
+
+
+@pytest.mark.parametrize("n", [1, 2, 3])
+def test_fused_call_equals_the_general_path_field_by_field(n):
+    rng = np.random.default_rng(40 + n)
+    bodies = random_rigid_bodies(rng, n)
+    s = int(rng.integers(1, 6 * n))
+    A, b = rng.normal(size=(s, 6 * n)), rng.normal(size=s)
+    fast = gmuk.System(bodies, [Rows(bodies, A, b)], forces=[gmuk.UniformGravity([0, 0, -9.8])])
+    slow = _general_path(
+        gmuk.System(bodies, [Rows(bodies, A, b)], forces=[gmuk.UniformGravity([0, 0, -9.8])])
+    )
+    assert fast._fused
+    state = random_state(fast, rng)
+    x, y = fast.accelerations(state), slow.accelerations(state)
+    for name in ("free", "constraint", "total", "constraint_force", "multipliers"):
+        u, v = getattr(x, name), getattr(y, name)
+        assert np.abs(u - v).max() <= 1e-12 * max(1.0, np.abs(v).max()), name
+    for name in ("extra", "control_force", "unmodeled_force", "z_dot"):
+        assert np.array_equal(getattr(x, name), getattr(y, name)), name
+    assert x.rank == y.rank == s
+    assert x.residual <= 1e-12 * max(1.0, np.abs(b).max())
+
+
+def test_tracking_one_body_fused_equals_general_path():
+    rng = np.random.default_rng(5)
+    (body,) = random_rigid_bodies(rng, 1)
+    ref = ScrewReference(np.eye(4), np.array([0.01, -0.02, 0.03, 1.0, 2.0, -0.5]))
+    make = lambda: gmuk.System([body], [gmuk.ConfigurationTracking(body, ref)])  # noqa: E731
+    fast, slow = make(), _general_path(make())
+    state = random_state(fast, rng).replace(t=2.5)
+    x, y = fast.accelerations(state), slow.accelerations(state)
+    assert np.allclose(x.total, y.total, rtol=1e-13, atol=1e-15)
+    assert np.allclose(x.multipliers, y.multipliers, rtol=1e-12, atol=1e-12)
+
+
+def test_fused_results_do_not_share_writable_memory():
+    rng = np.random.default_rng(6)
+    bodies = random_rigid_bodies(rng, 1)
+    system = gmuk.System(bodies, [Rows(bodies, rng.normal(size=(3, 6)), rng.normal(size=3))])
+    state = random_state(system, rng)
+    acc = system.accelerations(state)
+    free = acc.free.copy()
+    acc.total[:] = 0.0  # a user may scribble on a result …
+    assert np.array_equal(acc.free, free)  # … without changing another field
+    with pytest.raises(ValueError):
+        acc.extra[0] = 1.0  # the shared zero loads are read-only
+    assert np.array_equal(system.accelerations(state).extra, np.zeros(6))
+
+
+class _Broken(ReferenceTrajectory):
+    def __init__(self, kind):
+        self.kind = kind
+
+    def evaluate(self, t):
+        if self.kind == "nan":
+            return ReferenceState(np.eye(4), np.array([np.nan, 0, 0, 0, 0, 0]), np.zeros(6))
+        return ReferenceState(np.eye(3), np.zeros(6), np.zeros(6))
+
+
+def test_fused_path_still_names_a_constraint_with_non_finite_rows():
+    body = gmuk.RigidBody("a", 2.0, np.diag([1.0, 2.0, 2.5]))
+    system = gmuk.System([body], [gmuk.ConfigurationTracking(body, _Broken("nan"), name="trk")])
+    with pytest.raises(ConstraintError, match=r"'trk'.*NaN or inf"):
+        system.accelerations(system.state(g={"a": np.eye(4)}, V={"a": np.zeros(6)}))
+
+
+def test_reference_of_the_wrong_shape_is_an_error_not_a_stray_read():
+    body = gmuk.RigidBody("a", 2.0, np.diag([1.0, 2.0, 2.5]))
+    system = gmuk.System([body], [gmuk.ConfigurationTracking(body, _Broken("shape"), name="trk")])
+    with pytest.raises(ConstraintError, match=r"'trk'.*g \(3, 3\)"):
+        system.accelerations(system.state(g={"a": np.eye(4)}, V={"a": np.zeros(6)}))
