@@ -663,7 +663,8 @@ class System:
         self, state: State, a: FloatArray, rows: tuple[Any, FloatArray] | None = None
     ) -> tuple[FloatArray, FloatArray, int | None, float]:
         A, b = self._stack_rows(state, check_finite=False) if rows is None else rows
-        if not (all_finite((A.data if sp.issparse(A) else A).reshape(-1)) and all_finite(b)):
+        values = np.asarray(A.data if sp.issparse(A) else A).reshape(-1)
+        if not (all_finite(values) and all_finite(b)):
             self.constraint_rows(state)  # raises ConstraintError naming the constraint
             raise ConstraintError(f"constraint rows at t = {state.t:.9g} s are not finite")
         return self._solve_rows(state, a, A, b)
