@@ -16,7 +16,7 @@ import numpy as np
 from gmuk._validation import FloatArray
 from gmuk.trajectory import Trajectory
 
-__all__ = ["compare_body", "plot_body"]
+__all__ = ["compare_body", "plot_body", "plot_components", "plot_panels"]
 
 _AXES = ("1", "2", "3")
 
@@ -142,4 +142,90 @@ def compare_body(
             ttl = f"{title}: {labels[0]} and {labels[1]}"
             ylab = list(ylabels)
         paths += _figure(a.t, series, ylab, ttl, out_dir / f"{prefix}{key}", formats)
+    return paths
+
+
+def plot_components(
+    t: FloatArray,
+    series: Sequence[tuple[str, FloatArray]],
+    ylabels: Sequence[str],
+    title: str,
+    out: Path,
+    formats: Sequence[str] = ("png",),
+    t_label: str = "t (s)",
+) -> list[Path]:
+    """One 3-row figure of vector quantities: row k shows component k of every series.
+
+    Parameters
+    ----------
+    t : ndarray (N,)
+        Abscissa (s unless ``t_label`` says otherwise).
+    series : sequence of (label, ndarray (N, 3))
+        One line per series in each row; a legend when there are several.
+    ylabels : sequence of 3 str
+        Row labels with units, e.g. ``"Δr1 (m)"``.
+    title : str
+    out : Path
+        Output path without suffix; one file per format is written beside it.
+    formats : sequence of str
+    t_label : str
+
+    Returns
+    -------
+    list of Path
+    """
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return _figure(t, series, ylabels, title, out, formats, t_label)
+
+
+def plot_panels(
+    t: FloatArray,
+    panels: Sequence[tuple[str, Sequence[tuple[str, FloatArray, dict[str, Any]]]]],
+    title: str,
+    out: Path,
+    formats: Sequence[str] = ("png",),
+    t_label: str = "t (s)",
+) -> list[Path]:
+    """One figure with a row per panel, each with its own lines and styles.
+
+    Parameters
+    ----------
+    t : ndarray (N,)
+    panels : sequence of (ylabel, lines)
+        ``lines`` is a sequence of (label, y (N,), matplotlib line keywords such as
+        ``{"linestyle": "--", "color": "C1"}``). The legend is drawn in the first panel.
+    title : str
+    out : Path
+        Output path without suffix.
+    formats : sequence of str
+    t_label : str
+
+    Returns
+    -------
+    list of Path
+    """
+    plt = _pyplot()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig, axes = plt.subplots(
+        len(panels),
+        1,
+        sharex=True,
+        figsize=(7.5, 2.2 * len(panels) + 1.0),
+        constrained_layout=True,
+        squeeze=False,
+    )
+    for ax, (ylabel, lines) in zip(axes[:, 0], panels, strict=True):
+        for label, y, style in lines:
+            ax.plot(t, y, label=label, lw=1.2, **style)
+        ax.set_ylabel(ylabel)
+        ax.grid(True, alpha=0.3)
+    axes[-1, 0].set_xlabel(t_label)
+    axes[0, 0].legend(loc="best", fontsize=7, ncol=2)
+    fig.suptitle(title)
+    paths = []
+    for fmt in formats:
+        path = out.with_suffix(f".{fmt}")
+        fig.savefig(path, dpi=150)
+        paths.append(path)
+    plt.close(fig)
     return paths

@@ -21,6 +21,7 @@ __all__ = ["SCENARIOS", "ScenarioResult", "describe", "load"]
 
 #: Scenario names and the modules implementing them, in the thesis's order.
 SCENARIOS: dict[str, str] = {
+    "apollo16": "gmuk.scenarios.apollo16",
     "fccn": "gmuk.scenarios.fccn",
     "fcei": "gmuk.scenarios.fcei",
     "fceim": "gmuk.scenarios.fceim",
