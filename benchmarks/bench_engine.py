@@ -33,11 +33,15 @@ from gmuk.reference import ReferenceState, ReferenceTrajectory
 
 
 class Screw(ReferenceTrajectory):
+    """g_d(t) = exp(t ξ): constant twist, zero acceleration (a read-only constant)."""
+
     def __init__(self, xi):
         self.xi = np.asarray(xi, float)
+        self.zero = np.zeros(6)
+        self.zero.setflags(write=False)
 
     def evaluate(self, t):
-        return ReferenceState(se3.exp(t * self.xi), self.xi, np.zeros(6))
+        return ReferenceState(se3.exp(t * self.xi), self.xi, self.zero)
 
 
 class SparseRows(gmuk.Constraint):

@@ -102,11 +102,11 @@ class Accelerations:
     z_dot: FloatArray
 
     @classmethod
-    def _make(cls, **fields: Any) -> Accelerations:
+    def _from_dict(cls, fields: dict[str, Any]) -> Accelerations:
         # The frozen dataclass's __init__ sets 13 fields through object.__setattr__, a
         # measurable share of a one-body call; the System passes every field, by name.
         obj = object.__new__(cls)
-        obj.__dict__.update(fields)
+        object.__setattr__(obj, "__dict__", fields)
         return obj
 
     def of(self, body: Body | str, field: str = "total") -> FloatArray:
@@ -214,6 +214,11 @@ class System:
         # general path.
         self._zero_loads = np.zeros(self.layout.n_dof)
         self._zero_loads.setflags(write=False)
+        self._zero_z = self._zero_loads[:0]
+        # QR-eligible rows have s ≤ n, so the SVD's default rcond would be n·ε: certify
+        # κ ≤ min(QR_COND_LIMIT, 0.1/rcond) so that the QR never keeps a rank the SVD drops.
+        rc = self.rcond if self.rcond is not None else max(self.layout.n_dof, 1) * _EPS
+        self._qr_cond_limit = min(QR_COND_LIMIT, 0.1 / rc)
         self._single_dense = self._single_full_width and not (self.sparse or self.tangent_bundle)
         self._fused = not (
             self.sparse or self.tangent_bundle or self._plant_only_loads or self.layout.n_euclid
@@ -322,6 +327,13 @@ class System:
         lay = self.layout
         self._rigid_idx = (lay.rigid_offsets[:, None] + np.arange(6)).reshape(-1, 6)
         self._constraint_cols = [lay.columns(c.bodies) for c in self.constraints]
+        # A constraint's columns as a slice when contiguous (basic indexing is ~10× cheaper).
+        self._constraint_where: list[slice | np.ndarray] = [
+            slice(int(c[0]), int(c[-1]) + 1)
+            if c.size and np.array_equal(c, np.arange(c[0], c[-1] + 1))
+            else c
+            for c in self._constraint_cols
+        ]
         # One constraint spanning every dof in order: its A is the System's A as it stands.
         self._single_full_width = len(self._constraint_cols) == 1 and np.array_equal(
             self._constraint_cols[0], np.arange(lay.n_dof)
@@ -479,7 +491,7 @@ class System:
         self, state: State
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         if not (self.forces or self.controllers):  # shared, read-only zeros
-            return self._zero_loads, self._zero_loads, self._zero_loads, self._zero_loads[:0]
+            return self._zero_loads, self._zero_loads, self._zero_loads, self._zero_z
         n = self.layout.n_dof
         modeled, unmodeled, control = np.zeros(n), np.zeros(n), np.zeros(n)
         for f, bodies in zip(self.forces, self._force_bodies, strict=True):
@@ -567,8 +579,8 @@ class System:
             return np.ascontiguousarray(blocks[0][0]), b
         A = np.zeros((s, n))
         r0 = 0
-        for Ai, bi, cols in blocks:
-            A[r0 : r0 + bi.size, cols] = Ai.toarray() if sp.issparse(Ai) else Ai
+        for (Ai, bi, _), where in zip(blocks, self._constraint_where, strict=True):
+            A[r0 : r0 + bi.size, where] = Ai.toarray() if sp.issparse(Ai) else Ai
             r0 += bi.size
         return A, b
 
@@ -596,7 +608,6 @@ class System:
         if self._fused:
             rows = A, b = self._stack_rows(state, check_finite=False)
             if 0 < b.size <= QR_MAX_ROWS:
-                rcond = self.rcond if self.rcond is not None else max(A.shape) * _EPS
                 out = _uk_kernels.uk_rigid(
                     state.V,
                     modeled,
@@ -607,28 +618,30 @@ class System:
                     self._m_rigid,
                     self._Minv_sqrt,
                     self._M_dense,
-                    min(QR_COND_LIMIT, 0.1 / rcond),
+                    self._qr_cond_limit,
                     self.consistency_tol,
                 )
                 n, s = A.shape[1], b.size
-                status = out[-1]
+                status = float(out[-1])
                 if status == 3.0:
                     self._check_consistency(state, float(out[-3]), float(out[-2]))
                 if status == 0.0 or status == 3.0:  # certified full row rank: solved
-                    return Accelerations._make(
-                        layout=self.layout,
-                        free=out[:n],
-                        constraint=out[n : 2 * n],
-                        extra=self._zero_loads,  # no plant-only loads in a fused System
-                        total=out[2 * n : 3 * n],
-                        constraint_force=out[3 * n : 4 * n],
-                        control_force=control,
-                        unmodeled_force=unmodeled,
-                        multipliers=out[4 * n : 4 * n + s],
-                        residual=float(out[-3]),
-                        rank=s,
-                        unreachable=0.0,
-                        z_dot=z_dot,
+                    return Accelerations._from_dict(
+                        {
+                            "layout": self.layout,
+                            "free": out[:n],
+                            "constraint": out[n : 2 * n],
+                            "extra": self._zero_loads,  # a fused System has no plant-only loads
+                            "total": out[2 * n : 3 * n],
+                            "constraint_force": out[3 * n : 4 * n],
+                            "control_force": control,
+                            "unmodeled_force": unmodeled,
+                            "multipliers": out[4 * n : 4 * n + s],
+                            "residual": float(out[-3]),
+                            "rank": s,
+                            "unreachable": 0.0,
+                            "z_dot": z_dot,
+                        }
                     )
         a = self._free(state, modeled)
         if self._plant_only_loads:
@@ -643,20 +656,20 @@ class System:
         else:
             ac, lam, rank, residual = self._solve_r6(state, a, rows)
         total += ac
-        return Accelerations._make(
-            layout=self.layout,
-            free=a,
-            constraint=ac,
-            extra=extra,
-            total=total,
-            constraint_force=self._apply_M(ac),
-            control_force=control,
-            unmodeled_force=unmodeled,
-            multipliers=lam,
-            residual=residual,
-            rank=rank,
-            unreachable=unreachable,
-            z_dot=z_dot,
+        return Accelerations(
+            self.layout,
+            a,
+            ac,
+            extra,
+            total,
+            self._apply_M(ac),
+            control,
+            unmodeled,
+            lam,
+            residual,
+            rank,
+            unreachable,
+            z_dot,
         )
 
     def _solve_r6(

@@ -142,3 +142,23 @@ def test_reference_of_the_wrong_shape_is_an_error_not_a_stray_read():
     system = gmuk.System([body], [gmuk.ConfigurationTracking(body, _Broken("shape"), name="trk")])
     with pytest.raises(ConstraintError, match=r"'trk'.*g \(3, 3\)"):
         system.accelerations(system.state(g={"a": np.eye(4)}, V={"a": np.zeros(6)}))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_compiled_relative_rows_equal_eq_73_written_with_the_lie_operators(seed):
+    from gmuk.constraints.relative import relative_twist
+    from gmuk.lie import se3
+
+    rng = np.random.default_rng(seed)
+    S = np.eye(6)[[1, 2, 3, 4, 5]]
+    for _ in range(50):
+        g_L, g_B = se3.exp(rng.normal(size=6) * 3), se3.exp(rng.normal(size=6) * 3)
+        V_L, V_B, a_des = rng.normal(size=(3, 6))
+        g_BL, V_BL, AdV_L = relative_twist(g_L, V_L, g_B, V_B)
+        Ad_inv = se3.Ad(se3.inverse(g_BL))
+        A_ref = np.hstack([-S @ Ad_inv, S])
+        b_ref = S @ (a_des - se3.ad(V_BL) @ AdV_L)
+        A, b, V_rel = _uk_kernels.relative_rows(g_L, V_L, g_B, V_B, S, a_des)
+        assert np.allclose(A, A_ref, rtol=0, atol=1e-13 * np.abs(A_ref).max())
+        assert np.allclose(b, b_ref, rtol=0, atol=1e-13 * max(1.0, np.abs(b_ref).max()))
+        assert np.allclose(V_rel, V_BL, rtol=0, atol=1e-13 * np.abs(V_BL).max())

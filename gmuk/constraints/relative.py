@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk import _uk_kernels
 from gmuk._validation import FloatArray
 from gmuk.constraints.base import Baumgarte, Constraint
 from gmuk.errors import ConstraintError
@@ -31,6 +32,9 @@ if TYPE_CHECKING:
     from gmuk.state import State
 
 __all__ = ["RelativeConstraint", "relative_twist"]
+
+_ZERO6 = np.zeros(6)
+_ZERO6.setflags(write=False)
 
 
 def relative_twist(
@@ -108,17 +112,18 @@ class RelativeConstraint(Constraint):
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) with columns [V_L, V_B]."""
         L, B = self.bodies
-        g_BL, V_BL, AdV_L = relative_twist(
-            state.pose(L), state.twist(L), state.pose(B), state.twist(B)
+        if self.acceleration is None:
+            a_des = _ZERO6
+        else:
+            a_des = np.asarray(self.acceleration(state.t), dtype=np.float64)
+            if a_des.shape != (6,):
+                raise ConstraintError(
+                    f"constraint {self.name!r}: acceleration(t) returned shape {a_des.shape}; "
+                    "expected (6,)"
+                )
+        A, b, V_BL = _uk_kernels.relative_rows(
+            state.pose(L), state.twist(L), state.pose(B), state.twist(B), self.S, a_des
         )
-        Ad_inv = se3._Ad(se3._inverse(g_BL))
-        A = np.hstack([-self.S @ Ad_inv, self.S])
-        a_des = (
-            np.zeros(6)
-            if self.acceleration is None
-            else np.asarray(self.acceleration(state.t), dtype=float)
-        )
-        b = self.S @ (a_des - se3._ad(V_BL) @ AdV_L)
         if self.baumgarte is not None:
             v_des = (
                 np.zeros(6)

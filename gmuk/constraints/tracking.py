@@ -94,8 +94,8 @@ class ConfigurationTracking(Constraint):
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """A = I₆ and b of Eq. 67 (projected), plus Baumgarte terms."""
-        (body,) = self.bodies
-        g, V = state.pose(body), state.twist(body)
+        i = state._slot(self.bodies[0], "rigid", "pose").index
+        g, V = state.g[i], state.V[i]
         ref = self.reference.evaluate(state.t)
         gd = np.asarray(ref.g, dtype=np.float64)
         Vd = np.asarray(ref.V, dtype=np.float64)
