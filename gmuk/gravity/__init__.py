@@ -72,9 +72,17 @@ q_nm can overflow there; both are carried as extended-exponent numbers (mantissa
 formed, so terms that matter are never lost to underflow. No factorials are formed
 anywhere; every coefficient is a square root of a ratio of small integers.
 
-The kernel is compiled with numba (``gmuk.gravity._kernels``; one signature, cached on
-disk; ~6 s the first time, loaded from the cache afterwards). A field precomputes its
-recursion coefficients and square-root tables once, at construction or ``truncate``.
+The kernels are compiled with numba (``gmuk.gravity._kernels``; explicit signatures,
+cached on disk; 5-15 s on the first import on the project's shared 2-core machine, loaded
+from the cache afterwards). A field precomputes its recursion coefficients and
+square-root tables once, at construction or ``truncate``.
+
+Speed: a single position (a float64 array of shape (3,)) takes a fast path: one compiled
+call without numba's type dispatch, which writes the result over a copy of the input.
+Everything else (lists, other dtypes, batches) goes through the batch kernel; both run the
+same per-point code, so they agree bit for bit. Measured medians on the shared 2-core
+machine, beside pyshtools 4.14 in the same run, are in ``benchmarks/README.md``
+(``python benchmarks/bench_gravity.py``).
 
 Departures from McCann (2020)
 -----------------------------

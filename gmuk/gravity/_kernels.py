@@ -27,18 +27,48 @@ with ``L(N) = (N+1)(N+2)/2``.
 Indices inside the loops are unsigned (``uint64``) so that no negative-index wraparound
 test is compiled into them (numba adds one for signed indices, which costs about a third
 of the time of these loops and prevents vectorisation).
+
+Workspace
+---------
+:func:`_point` evaluates one point with a workspace of ``8 W + 26`` floats, ``W`` being
+one more than the highest degree of solid harmonic needed: eight solid-harmonic columns
+(a ring buffer indexed by ``m mod 8``, ``W`` values each), the eight column seeds σ
+(real parts, then imaginary parts) and ten results (U, ∇U, and the upper triangle of the
+Hessian, row by row). :func:`evaluate` loops over points with one workspace; the
+``*_at`` kernels are the single-point entries used by the public single-point calls.
+
+Calling without numba's dispatcher
+----------------------------------
+Numba's dispatcher resolves argument types on every call (≈ 0.3–0.8 µs here, more than a
+degree-10 field costs to evaluate). :func:`entry` returns the compiled function of a
+single-signature kernel, which skips that resolution; it does not check the arguments
+beyond their item size, so callers must pass exactly the declared types (float64,
+C-contiguous, the declared number of dimensions). :mod:`gmuk.gravity.field` does.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit, types, uint64
 
 from gmuk._validation import FloatArray
 
-__all__ = ["HEADER", "evaluate", "field_data", "offsets"]
+__all__ = [
+    "HEADER",
+    "acceleration_at",
+    "acceleration_hessian_at",
+    "entry",
+    "evaluate",
+    "field_data",
+    "offsets",
+    "perturbation_acceleration_at",
+    "perturbation_potential_at",
+    "potential_at",
+    "workspace_size",
+]
 
 #: Length of the header of the field data vector.
 HEADER = 8
@@ -160,6 +190,17 @@ def field_data(mu: float, radius: float, C: FloatArray, S: FloatArray) -> FloatA
     return d
 
 
+@njit(cache=True)
+def _rescale(Q, base, count):  # type: ignore[no-untyped-def]
+    """``Q[base : base + count] *= BIG⁻¹``: the rare overflow branch of :func:`_q_column`.
+
+    A function of its own so that the loop of :func:`_q_column` stays short (inline, LLVM
+    hoisted this loop's bounds into every step of the recursion).
+    """
+    for i in range(count):
+        Q[base + uint64(i)] *= BIGI
+
+
 @njit(cache=True, fastmath={"contract"})
 def _q_column(d, oa, ob, j, M, rhou, rho2, Q, qo):  # type: ignore[no-untyped-def]
     """Real part q_n, n = j..M, of solid-harmonic column j, with q_j = 1.
@@ -182,8 +223,7 @@ def _q_column(d, oa, ob, j, M, rhou, rho2, Q, qo):  # type: ignore[no-untyped-de
         p2 = p1
         p1 = c
         if abs(c) > BIG:
-            for i2 in range(i + 1):
-                Q[base_q + uint64(i2)] *= BIGI
+            _rescale(Q, base_q, i + 1)
             p1 *= BIGI
             p2 *= BIGI
             e += 1
@@ -293,6 +333,260 @@ def _hessian_sums(d, oc, os_, oF, oha, ohb, oga, ogb, Q, q0, qp, qpp, qm, qmm, L
     return xc, xs, yc, ys, zc, zs, uc, us, vc, vs
 
 
+@njit(cache=True)
+def _point(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
+    """Values at one body-fixed point (x, y, z) (m), left in the workspace ``Q``.
+
+    ``mode`` as in :func:`evaluate`; ``Q`` of at least :func:`workspace_size` floats with
+    its seed section (``Q[8W : 8W + 16]``) zeroed. On success (status 0) the results are
+    ``Q[8W + 16]`` = U, ``Q[8W + 17 : 8W + 20]`` = ∇U and ``Q[8W + 20 : 8W + 26]`` =
+    (H_xx, H_xy, H_xz, H_yy, H_yz, H_zz), those requested by ``mode``. Otherwise the
+    status: 1 non-finite input, 2 the origin, 3 a non-finite result.
+    """
+    N = int(d[0])
+    mu = d[1]
+    R = d[2]
+    want_u = (mode & 1) != 0
+    want_a = (mode & 2) != 0
+    want_h = (mode & 4) != 0
+    skip0 = (mode & 8) != 0
+    lead = 2 if want_h else (1 if want_a else 0)
+    M = N + 2
+    Mc = N + lead  # highest degree of solid harmonic needed
+    L = _tri(N)
+    LM = _tri(M)
+    oC = HEADER
+    oS = oC + L
+    oA = oS + L
+    oB = oA + LM
+    of = oB + LM
+    oF = of + M + 2
+    oh = oF + M + 2
+    oG = oh + 2 * M + 8
+    W = Mc + 1
+    W8 = 8 * W  # the seeds σ follow the eight columns: real parts, imaginary parts
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+        return BAD_INPUT
+    rn = math.sqrt(x * x + y * y + z * z)
+    if rn == 0.0:
+        return AT_ORIGIN
+    rho = R / rn
+    s = x / rn
+    t = y / rn
+    rhou = rho * z / rn
+    rho2 = rho * rho
+    # seed σ_j of solid-harmonic column j: mantissa (sr, si) times BIG^se
+    sr = rho
+    si = 0.0
+    se = 0
+    zero_from = Mc + 1  # columns from here on are identically zero (x = y = 0)
+    done = -1
+    pot = 0.0
+    gpr = 0.0
+    gpi = 0.0
+    gmr = 0.0
+    gmi = 0.0
+    gz = 0.0
+    hppr = 0.0
+    hppi = 0.0
+    hmmr = 0.0
+    hmmi = 0.0
+    hzz = 0.0
+    hpzr = 0.0
+    hpzi = 0.0
+    hmzr = 0.0
+    hmzi = 0.0
+    for m in range(N + 1):
+        if m - lead >= zero_from:
+            break
+        # solid-harmonic columns m - 2 .. m + lead must be available
+        while done < m + lead:
+            j = done + 1
+            slot = j & 7
+            qo = slot * W
+            if j > 0 and j < zero_from:
+                kj = d[oA + _col(j, M)]
+                fr = kj * rho * s
+                fi = kj * rho * t
+                nr = fr * sr - fi * si
+                si = fr * si + fi * sr
+                sr = nr
+                mag = max(abs(sr), abs(si))
+                if mag == 0.0:
+                    zero_from = j
+                else:
+                    while mag < BIGI:
+                        sr *= BIG
+                        si *= BIG
+                        mag *= BIG
+                        se -= 1
+                    while se < 0 and mag >= 1.0:
+                        sr *= BIGI
+                        si *= BIGI
+                        mag *= BIGI
+                        se += 1
+            if j < zero_from:
+                oa = oA + _col(j, M)
+                ob = oB + _col(j, M)
+                e = se + _q_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo)
+                er = sr
+                ei = si
+                while e > 0:
+                    er *= BIG
+                    ei *= BIG
+                    e -= 1
+                while e < 0:
+                    er *= BIGI
+                    ei *= BIGI
+                    e += 1
+                Q[W8 + slot] = er
+                Q[W8 + 8 + slot] = ei
+            else:
+                for k in range(j, Mc + 1):
+                    Q[qo + k] = 0.0
+                Q[W8 + slot] = 0.0
+                Q[W8 + 8 + slot] = 0.0
+            done = j
+        n0 = 1 if (skip0 and m == 0) else m
+        Lm = N + 1 - n0
+        if Lm <= 0:
+            continue
+        cofs = _col(m, N) + n0 - m
+        q0 = (m & 7) * W
+        qp = ((m + 1) & 7) * W
+        qm = ((m - 1) & 7) * W if m >= 1 else qp
+        s0r = Q[W8 + (m & 7)]
+        s0i = Q[W8 + 8 + (m & 7)]
+        spr = Q[W8 + ((m + 1) & 7)]
+        spi = Q[W8 + 8 + ((m + 1) & 7)]
+        if want_u:
+            uc, us = _potential_sums(d, oC + cofs, oS + cofs, Q, q0 + n0, Lm)
+            pot += uc * s0r + us * s0i
+        if want_a:
+            k1 = n0 + 1
+            zc, zs, pc, ps, mc, ms = _gradient_sums(
+                d, oC + cofs, oS + cofs, of + n0,
+                oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
+                Q, q0 + k1, qp + k1, qm + k1, Lm,
+            )  # fmt: skip
+            gz += zc * s0r + zs * s0i
+            if m == 0:
+                pc *= ISQRT2
+                gpr += pc * spr
+                gpi += pc * spi
+                gmr -= pc * spr
+                gmi += pc * spi
+            else:
+                gpr += pc * spr + ps * spi
+                gpi += pc * spi - ps * spr
+                if m == 1:
+                    mc *= SQRT2
+                    ms *= SQRT2
+                smr = Q[W8 + ((m - 1) & 7)]
+                smi = Q[W8 + 8 + ((m - 1) & 7)]
+                gmr += mc * smr + ms * smi
+                gmi += mc * smi - ms * smr
+        if want_h:
+            k2 = n0 + 2
+            qpp = ((m + 2) & 7) * W
+            qmm = ((m - 2) & 7) * W if m >= 2 else qp
+            xc, xs, yc, ys, zc, zs, uc, us, vc, vs = _hessian_sums(
+                d, oC + cofs, oS + cofs, oF + n0,
+                oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
+                Q, q0 + k2, qp + k2, qpp + k2, qm + k2, qmm + k2, Lm,
+            )  # fmt: skip
+            sppr = Q[W8 + ((m + 2) & 7)]
+            sppi = Q[W8 + 8 + ((m + 2) & 7)]
+            hzz += zc * s0r + zs * s0i
+            if m == 0:
+                # S[n, 0] = 0; the lowering operator acts on the conjugate
+                xc *= ISQRT2
+                yc *= ISQRT2
+                hppr += xc * sppr
+                hppi += xc * sppi
+                hpzr += yc * spr
+                hpzi += yc * spi
+                hmzr += yc * spr
+                hmzi -= yc * spi
+                hmmr += xc * sppr
+                hmmi -= xc * sppi
+            else:
+                hppr += xc * sppr + xs * sppi
+                hppi += xc * sppi - xs * sppr
+                hpzr += yc * spr + ys * spi
+                hpzi += yc * spi - ys * spr
+                smr = Q[W8 + ((m - 1) & 7)]
+                smi = Q[W8 + 8 + ((m - 1) & 7)]
+                if m == 1:
+                    uc *= SQRT2
+                    us *= SQRT2
+                    # lowering twice from order 1 lands on the conjugate of order 1
+                    hmmr -= zc * s0r - zs * s0i
+                    hmmi += zc * s0i + zs * s0r
+                else:
+                    if m == 2:
+                        vc *= SQRT2
+                        vs *= SQRT2
+                    smmr = Q[W8 + ((m - 2) & 7)]
+                    smmi = Q[W8 + 8 + ((m - 2) & 7)]
+                    hmmr += vc * smmr + vs * smmi
+                    hmmi += vc * smmi - vs * smmr
+                hmzr -= uc * smr + us * smi
+                hmzi -= uc * smi - us * smr
+    o = W8 + 16
+    if want_u:
+        u = (mu / R) * pot
+        if not math.isfinite(u):
+            return BAD_OUTPUT
+        Q[o] = u
+    if want_a:
+        k_ = 0.5 * mu / (R * R)
+        ax = k_ * (gmr - gpr)
+        ay = -k_ * (gpi + gmi)
+        az = -2.0 * k_ * gz
+        if not (math.isfinite(ax) and math.isfinite(ay) and math.isfinite(az)):
+            return BAD_OUTPUT
+        Q[o + 1] = ax
+        Q[o + 2] = ay
+        Q[o + 3] = az
+    if want_h:
+        k_ = mu / (R * R * R)
+        hxx = 0.25 * k_ * (hppr + hmmr - 2.0 * hzz)
+        hyy = -0.25 * k_ * (hppr + hmmr + 2.0 * hzz)
+        hxy = 0.25 * k_ * (hppi - hmmi)
+        hxz = 0.5 * k_ * (hpzr + hmzr)
+        hyz = 0.5 * k_ * (hpzi - hmzi)
+        hz = k_ * hzz
+        if not (
+            math.isfinite(hxx) and math.isfinite(hyy) and math.isfinite(hz)
+            and math.isfinite(hxy) and math.isfinite(hxz) and math.isfinite(hyz)
+        ):  # fmt: skip
+            return BAD_OUTPUT
+        Q[o + 4] = hxx
+        Q[o + 5] = hxy
+        Q[o + 6] = hxz
+        Q[o + 7] = hyy
+        Q[o + 8] = hyz
+        Q[o + 9] = hz
+    return OK
+
+
+@njit(cache=True, inline="always")
+def workspace_size(N: int, mode: int) -> int:
+    """Length of the workspace of :func:`_point` for degree N and ``mode``."""
+    lead = 2 if (mode & 4) != 0 else (1 if (mode & 2) != 0 else 0)
+    return 8 * (N + lead + 1) + 26
+
+
+@njit(cache=True, inline="always")
+def _workspace(N, mode):  # type: ignore[no-untyped-def]
+    """A workspace for :func:`_point` (seed section zeroed) and the offset of its results."""
+    size = workspace_size(N, mode)
+    Q = np.empty(size)
+    Q[size - 26 :] = 0.0
+    return Q, size - 10
+
+
 # One explicit signature: positions typed read-only accept writable arrays as well, so a
 # read-only input never triggers a second compilation. Compiled (or loaded from numba's
 # on-disk cache) when this module is imported.
@@ -320,241 +614,121 @@ def evaluate(d, r, out, hess, mode):  # type: ignore[no-untyped-def]
         0, or ``code + 4 i`` for the first failing point i: code 1 non-finite input,
         2 point at the origin, 3 non-finite result.
     """
-    N = int(d[0])
-    mu = d[1]
-    R = d[2]
     want_u = (mode & 1) != 0
     want_a = (mode & 2) != 0
     want_h = (mode & 4) != 0
-    skip0 = (mode & 8) != 0
-    lead = 2 if want_h else (1 if want_a else 0)
-    M = N + 2
-    Mc = N + lead  # highest degree of solid harmonic needed
-    L = _tri(N)
-    LM = _tri(M)
-    oC = HEADER
-    oS = oC + L
-    oA = oS + L
-    oB = oA + LM
-    of = oB + LM
-    oF = of + M + 2
-    oh = oF + M + 2
-    oG = oh + 2 * M + 8
     stride = (1 if want_u else 0) + (3 if want_a else 0)
-    npts = r.shape[0] // 3
-    W = Mc + 1
-    Q = np.empty(8 * W)
-    sig_r = np.zeros(8)
-    sig_i = np.zeros(8)
-    for ip in range(npts):
-        x = r[3 * ip]
-        y = r[3 * ip + 1]
-        z = r[3 * ip + 2]
-        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
-            return BAD_INPUT + 4 * ip
-        rn = math.sqrt(x * x + y * y + z * z)
-        if rn == 0.0:
-            return AT_ORIGIN + 4 * ip
-        rho = R / rn
-        s = x / rn
-        t = y / rn
-        rhou = rho * z / rn
-        rho2 = rho * rho
-        # seed σ_j of solid-harmonic column j: mantissa (sr, si) times BIG^se
-        sr = rho
-        si = 0.0
-        se = 0
-        zero_from = Mc + 1  # columns from here on are identically zero (x = y = 0)
-        done = -1
-        pot = 0.0
-        gpr = 0.0
-        gpi = 0.0
-        gmr = 0.0
-        gmi = 0.0
-        gz = 0.0
-        hppr = 0.0
-        hppi = 0.0
-        hmmr = 0.0
-        hmmi = 0.0
-        hzz = 0.0
-        hpzr = 0.0
-        hpzi = 0.0
-        hmzr = 0.0
-        hmzi = 0.0
-        for m in range(N + 1):
-            if m - lead >= zero_from:
-                break
-            # solid-harmonic columns m - 2 .. m + lead must be available
-            while done < m + lead:
-                j = done + 1
-                slot = j & 7
-                qo = slot * W
-                if j > 0 and j < zero_from:
-                    kj = d[oA + _col(j, M)]
-                    fr = kj * rho * s
-                    fi = kj * rho * t
-                    nr = fr * sr - fi * si
-                    si = fr * si + fi * sr
-                    sr = nr
-                    mag = max(abs(sr), abs(si))
-                    if mag == 0.0:
-                        zero_from = j
-                    else:
-                        while mag < BIGI:
-                            sr *= BIG
-                            si *= BIG
-                            mag *= BIG
-                            se -= 1
-                        while se < 0 and mag >= 1.0:
-                            sr *= BIGI
-                            si *= BIGI
-                            mag *= BIGI
-                            se += 1
-                if j < zero_from:
-                    oa = oA + _col(j, M)
-                    ob = oB + _col(j, M)
-                    e = se + _q_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo)
-                    er = sr
-                    ei = si
-                    while e > 0:
-                        er *= BIG
-                        ei *= BIG
-                        e -= 1
-                    while e < 0:
-                        er *= BIGI
-                        ei *= BIGI
-                        e += 1
-                    sig_r[slot] = er
-                    sig_i[slot] = ei
-                else:
-                    for k in range(j, Mc + 1):
-                        Q[qo + k] = 0.0
-                    sig_r[slot] = 0.0
-                    sig_i[slot] = 0.0
-                done = j
-            n0 = 1 if (skip0 and m == 0) else m
-            Lm = N + 1 - n0
-            if Lm <= 0:
-                continue
-            cofs = _col(m, N) + n0 - m
-            q0 = (m & 7) * W
-            qp = ((m + 1) & 7) * W
-            qm = ((m - 1) & 7) * W if m >= 1 else qp
-            s0r = sig_r[m & 7]
-            s0i = sig_i[m & 7]
-            spr = sig_r[(m + 1) & 7]
-            spi = sig_i[(m + 1) & 7]
-            if want_u:
-                uc, us = _potential_sums(d, oC + cofs, oS + cofs, Q, q0 + n0, Lm)
-                pot += uc * s0r + us * s0i
-            if want_a:
-                k1 = n0 + 1
-                zc, zs, pc, ps, mc, ms = _gradient_sums(
-                    d, oC + cofs, oS + cofs, of + n0,
-                    oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
-                    Q, q0 + k1, qp + k1, qm + k1, Lm,
-                )  # fmt: skip
-                gz += zc * s0r + zs * s0i
-                if m == 0:
-                    pc *= ISQRT2
-                    gpr += pc * spr
-                    gpi += pc * spi
-                    gmr -= pc * spr
-                    gmi += pc * spi
-                else:
-                    gpr += pc * spr + ps * spi
-                    gpi += pc * spi - ps * spr
-                    if m == 1:
-                        mc *= SQRT2
-                        ms *= SQRT2
-                    smr = sig_r[(m - 1) & 7]
-                    smi = sig_i[(m - 1) & 7]
-                    gmr += mc * smr + ms * smi
-                    gmi += mc * smi - ms * smr
-            if want_h:
-                k2 = n0 + 2
-                qpp = ((m + 2) & 7) * W
-                qmm = ((m - 2) & 7) * W if m >= 2 else qp
-                xc, xs, yc, ys, zc, zs, uc, us, vc, vs = _hessian_sums(
-                    d, oC + cofs, oS + cofs, oF + n0,
-                    oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
-                    Q, q0 + k2, qp + k2, qpp + k2, qm + k2, qmm + k2, Lm,
-                )  # fmt: skip
-                sppr = sig_r[(m + 2) & 7]
-                sppi = sig_i[(m + 2) & 7]
-                hzz += zc * s0r + zs * s0i
-                if m == 0:
-                    # S[n, 0] = 0; the lowering operator acts on the conjugate
-                    xc *= ISQRT2
-                    yc *= ISQRT2
-                    hppr += xc * sppr
-                    hppi += xc * sppi
-                    hpzr += yc * spr
-                    hpzi += yc * spi
-                    hmzr += yc * spr
-                    hmzi -= yc * spi
-                    hmmr += xc * sppr
-                    hmmi -= xc * sppi
-                else:
-                    hppr += xc * sppr + xs * sppi
-                    hppi += xc * sppi - xs * sppr
-                    hpzr += yc * spr + ys * spi
-                    hpzi += yc * spi - ys * spr
-                    smr = sig_r[(m - 1) & 7]
-                    smi = sig_i[(m - 1) & 7]
-                    if m == 1:
-                        uc *= SQRT2
-                        us *= SQRT2
-                        # lowering twice from order 1 lands on the conjugate of order 1
-                        hmmr -= zc * s0r - zs * s0i
-                        hmmi += zc * s0i + zs * s0r
-                    else:
-                        if m == 2:
-                            vc *= SQRT2
-                            vs *= SQRT2
-                        smmr = sig_r[(m - 2) & 7]
-                        smmi = sig_i[(m - 2) & 7]
-                        hmmr += vc * smmr + vs * smmi
-                        hmmi += vc * smmi - vs * smmr
-                    hmzr -= uc * smr + us * smi
-                    hmzi -= uc * smi - us * smr
-        o = ip * stride
+    Q, o = _workspace(int(d[0]), mode)
+    for ip in range(r.shape[0] // 3):
+        code = _point(d, r[3 * ip], r[3 * ip + 1], r[3 * ip + 2], mode, Q)
+        if code:
+            return code + 4 * ip
+        k = ip * stride
         if want_u:
-            out[o] = (mu / R) * pot
-            if not math.isfinite(out[o]):
-                return BAD_OUTPUT + 4 * ip
-            o += 1
+            out[k] = Q[o]
+            k += 1
         if want_a:
-            k_ = 0.5 * mu / (R * R)
-            out[o] = k_ * (gmr - gpr)
-            out[o + 1] = -k_ * (gpi + gmi)
-            out[o + 2] = -2.0 * k_ * gz
-            if not (
-                math.isfinite(out[o]) and math.isfinite(out[o + 1]) and math.isfinite(out[o + 2])
-            ):
-                return BAD_OUTPUT + 4 * ip
-            o += 3
+            out[k] = Q[o + 1]
+            out[k + 1] = Q[o + 2]
+            out[k + 2] = Q[o + 3]
         if want_h:
-            k_ = mu / (R * R * R)
-            hxx = 0.25 * k_ * (hppr + hmmr - 2.0 * hzz)
-            hyy = -0.25 * k_ * (hppr + hmmr + 2.0 * hzz)
-            hxy = 0.25 * k_ * (hppi - hmmi)
-            hxz = 0.5 * k_ * (hpzr + hmzr)
-            hyz = 0.5 * k_ * (hpzi - hmzi)
-            hz = k_ * hzz
             h0 = 3 * ip
-            hess[h0, 0] = hxx
-            hess[h0, 1] = hxy
-            hess[h0, 2] = hxz
-            hess[h0 + 1, 0] = hxy
-            hess[h0 + 1, 1] = hyy
-            hess[h0 + 1, 2] = hyz
-            hess[h0 + 2, 0] = hxz
-            hess[h0 + 2, 1] = hyz
-            hess[h0 + 2, 2] = hz
-            if not (
-                math.isfinite(hxx) and math.isfinite(hyy) and math.isfinite(hz)
-                and math.isfinite(hxy) and math.isfinite(hxz) and math.isfinite(hyz)
-            ):  # fmt: skip
-                return BAD_OUTPUT + 4 * ip
+            hess[h0, 0] = Q[o + 4]
+            hess[h0, 1] = Q[o + 5]
+            hess[h0, 2] = Q[o + 6]
+            hess[h0 + 1, 0] = Q[o + 5]
+            hess[h0 + 1, 1] = Q[o + 7]
+            hess[h0 + 1, 2] = Q[o + 8]
+            hess[h0 + 2, 0] = Q[o + 6]
+            hess[h0 + 2, 1] = Q[o + 8]
+            hess[h0 + 2, 2] = Q[o + 9]
     return OK
+
+
+@njit(cache=True, inline="always")
+def _at(d, buf, mode):  # type: ignore[no-untyped-def]
+    """:func:`_point` at the position ``buf[:3]``: (status, workspace, results offset)."""
+    Q, o = _workspace(int(d[0]), mode)
+    return _point(d, buf[0], buf[1], buf[2], mode, Q), Q, o
+
+
+# Single-point entries, one per request so that no mode argument is unboxed on the hot
+# path. Each takes the field data and a fresh float64 array of shape (3,) holding the
+# body-fixed position (m), overwrites it with the result, and returns the status code of
+# :func:`evaluate` for one point (the array is left unchanged on failure). The modes are
+# passed as np.int64(...), not as bare literals: numba would otherwise compile the large
+# :func:`_point` once per literal value (four more compilations, ≈ 10 s on first import).
+
+
+@njit(types.int64(_RO, _RW), cache=True)
+def acceleration_at(d, buf):  # type: ignore[no-untyped-def]
+    """∇U (m/s²) at one point, written over the position ``buf``."""
+    code, Q, o = _at(d, buf, np.int64(2))
+    if code == OK:
+        buf[0] = Q[o + 1]
+        buf[1] = Q[o + 2]
+        buf[2] = Q[o + 3]
+    return code
+
+
+@njit(types.int64(_RO, _RW), cache=True)
+def perturbation_acceleration_at(d, buf):  # type: ignore[no-untyped-def]
+    """∇U without the central term (m/s²) at one point, written over ``buf``."""
+    code, Q, o = _at(d, buf, np.int64(10))
+    if code == OK:
+        buf[0] = Q[o + 1]
+        buf[1] = Q[o + 2]
+        buf[2] = Q[o + 3]
+    return code
+
+
+@njit(types.int64(_RO, _RW), cache=True)
+def potential_at(d, buf):  # type: ignore[no-untyped-def]
+    """U (m²/s²) at one point, written to ``buf[0]``."""
+    code, Q, o = _at(d, buf, np.int64(1))
+    if code == OK:
+        buf[0] = Q[o]
+    return code
+
+
+@njit(types.int64(_RO, _RW), cache=True)
+def perturbation_potential_at(d, buf):  # type: ignore[no-untyped-def]
+    """U without the central term (m²/s²) at one point, written to ``buf[0]``."""
+    code, Q, o = _at(d, buf, np.int64(9))
+    if code == OK:
+        buf[0] = Q[o]
+    return code
+
+
+@njit(types.int64(_RO, _RW, _RW2, types.int64), cache=True)
+def acceleration_hessian_at(d, buf, hess, mode):  # type: ignore[no-untyped-def]
+    """∇U written over ``buf`` and ∇∇U into ``hess`` (3, 3), in one pass (mode 6 or 14)."""
+    code, Q, o = _at(d, buf, (mode & 8) | 6)
+    if code == OK:
+        buf[0] = Q[o + 1]
+        buf[1] = Q[o + 2]
+        buf[2] = Q[o + 3]
+        hess[0, 0] = Q[o + 4]
+        hess[0, 1] = Q[o + 5]
+        hess[0, 2] = Q[o + 6]
+        hess[1, 0] = Q[o + 5]
+        hess[1, 1] = Q[o + 7]
+        hess[1, 2] = Q[o + 8]
+        hess[2, 0] = Q[o + 6]
+        hess[2, 1] = Q[o + 8]
+        hess[2, 2] = Q[o + 9]
+    return code
+
+
+def entry(kernel: Any) -> Any:
+    """The compiled function of a single-signature kernel, callable without dispatch.
+
+    Falls back to the dispatcher itself if numba does not expose the compiled function.
+    The caller must pass exactly the declared argument types (see the module docstring).
+    """
+    overloads = list(getattr(kernel, "overloads", {}).values())
+    if len(overloads) == 1:
+        fn = getattr(overloads[0], "entry_point", None)
+        if callable(fn):
+            return fn
+    return kernel

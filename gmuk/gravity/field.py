@@ -25,7 +25,16 @@ from gmuk.gravity import _kernels
 
 __all__ = ["FieldValues", "SphericalHarmonicField"]
 
-_evaluate = _kernels.evaluate
+#: The compiled kernels, called without numba's type dispatch (see
+#: :func:`gmuk.gravity._kernels.entry`): every call below passes float64, C-contiguous arrays
+#: of the declared number of dimensions (positions pass through :func:`_points` or are a
+#: fresh copy checked to be float64 of shape (3,)).
+_evaluate = _kernels.entry(_kernels.evaluate)
+_acceleration_at = _kernels.entry(_kernels.acceleration_at)
+_perturbation_acceleration_at = _kernels.entry(_kernels.perturbation_acceleration_at)
+_potential_at = _kernels.entry(_kernels.potential_at)
+_perturbation_potential_at = _kernels.entry(_kernels.perturbation_potential_at)
+_acceleration_hessian_at = _kernels.entry(_kernels.acceleration_hessian_at)
 
 # mode bits of the kernel
 _POT = 1
@@ -38,6 +47,9 @@ _STRIDE = (0, 1, 3, 4, 0, 1, 3, 4)
 _NO_OUT = np.empty(0)
 _NO_HESS = np.empty((0, 3))
 _new_values = tuple.__new__  # FieldValues without the NamedTuple constructor's overhead
+_array = np.array  # np.array(r_F): always a new array, so the kernel may write into it
+_F64 = np.dtype(np.float64)
+_SHAPE3 = (3,)
 
 _NORMALIZATIONS = ("4pi", "unnormalized")
 
@@ -399,15 +411,17 @@ class SphericalHarmonicField:
         float or ndarray, shape (k,)
         """
         try:
-            r = np.ascontiguousarray(r_F, dtype=np.float64)
+            buf = _array(r_F)
         except (TypeError, ValueError):
-            r = _points(r_F)
-        if r.shape == (3,):
-            out = np.empty(1)
-            code = _evaluate(self._data, r, out, _NO_HESS, _POT if central else _POT | _NO_CENTRAL)
+            buf = _points(r_F)
+        if buf.dtype is _F64 and buf.shape == _SHAPE3:  # fast path: one point, in place
+            if central:
+                code = _potential_at(self._data, buf)
+            else:
+                code = _perturbation_potential_at(self._data, buf)
             if code:
-                raise self._failure(code, r)
-            return float(out[0])
+                raise self._failure(code, buf)
+            return float(buf[0])
         return self._batch(_points(r_F), _POT, central).potential  # type: ignore[return-value]
 
     def acceleration(self, r_F: Any, *, central: bool = True) -> FloatArray:
@@ -435,15 +449,17 @@ class SphericalHarmonicField:
             A position at the origin, or where the series does not give a finite value.
         """
         try:
-            r = np.ascontiguousarray(r_F, dtype=np.float64)
+            buf = _array(r_F)
         except (TypeError, ValueError):
-            r = _points(r_F)
-        if r.shape == (3,):
-            out = np.empty(3)
-            code = _evaluate(self._data, r, out, _NO_HESS, _ACC if central else _ACC | _NO_CENTRAL)
+            buf = _points(r_F)
+        if buf.dtype is _F64 and buf.shape == _SHAPE3:  # fast path: one point, in place
+            if central:
+                code = _acceleration_at(self._data, buf)
+            else:
+                code = _perturbation_acceleration_at(self._data, buf)
             if code:
-                raise self._failure(code, r)
-            return out
+                raise self._failure(code, buf)
+            return buf
         return self._batch(_points(r_F), _ACC, central).acceleration  # type: ignore[return-value]
 
     def hessian(self, r_F: Any, *, central: bool = True) -> FloatArray:
@@ -462,10 +478,10 @@ class SphericalHarmonicField:
             Symmetric; its trace is zero (Laplace) to round-off.
         """
         try:
-            r = np.ascontiguousarray(r_F, dtype=np.float64)
+            r = _array(r_F)
         except (TypeError, ValueError):
             r = _points(r_F)
-        if r.shape == (3,):
+        if r.dtype is _F64 and r.shape == _SHAPE3:
             H = np.empty((3, 3))
             code = _evaluate(self._data, r, _NO_OUT, H, _HES if central else _HES | _NO_CENTRAL)
             if code:
@@ -485,7 +501,10 @@ class SphericalHarmonicField:
         """Potential, acceleration and/or Hessian in one pass over the coefficients.
 
         One recursion of the solid harmonics serves every requested quantity, so asking for
-        acceleration and Hessian together costs about 1.5× the acceleration alone (not 2×).
+        acceleration and Hessian together costs less than the two calls
+        :meth:`acceleration` and :meth:`hessian` (measured ratios to the acceleration alone
+        are in ``benchmarks/README.md``). A single position with ``potential=False,
+        acceleration=True, hessian=True`` takes a dedicated fast path.
 
         Parameters
         ----------
@@ -508,17 +527,21 @@ class SphericalHarmonicField:
                 "evaluate: request at least one of potential, acceleration, hessian"
             )
         try:
-            r = np.ascontiguousarray(r_F, dtype=np.float64)
+            r = _array(r_F)
         except (TypeError, ValueError):
             r = _points(r_F)
-        if r.shape == (3,):
+        if r.dtype is _F64 and r.shape == _SHAPE3:
+            if mode == _ACC | _HES:  # the usual request of rigid-body gravity (fast path)
+                H = np.empty((3, 3))
+                code = _acceleration_hessian_at(self._data, r, H, 6 if central else 14)
+                if code:
+                    raise self._failure(code, r)
+                return _new_values(FieldValues, (None, r, H))
             out = np.empty(_STRIDE[mode])
             H = np.empty((3, 3)) if mode & _HES else _NO_HESS
             code = _evaluate(self._data, r, out, H, mode if central else mode | _NO_CENTRAL)
             if code:
                 raise self._failure(code, r)
-            if mode == _ACC | _HES:
-                return _new_values(FieldValues, (None, out, H))
             pot = float(out[0]) if mode & _POT else None
             acc = (out[1:] if mode & _POT else out) if mode & _ACC else None
             return _new_values(FieldValues, (pot, acc, H if mode & _HES else None))

@@ -1,0 +1,136 @@
+"""The single-point fast path of SphericalHarmonicField equals the general path bit for bit.
+
+Single positions of shape (3,) and dtype float64 go to dedicated compiled entries
+(``gmuk.gravity._kernels.*_at``) called without numba's type dispatch; every other input goes
+through the batch kernel. Both run the same per-point code, so their numbers must agree
+exactly, and the fast path must not touch the caller's array.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gmuk.errors import DomainError, NonFiniteError, ShapeError
+from gmuk.gravity import _kernels, moon_low_degree
+
+from .refs import kaula_field
+
+
+def _fields():
+    return [
+        kaula_field(0, seed=1),
+        kaula_field(1, seed=1),
+        kaula_field(2, seed=2, amplitude=1e-4),
+        moon_low_degree(),
+        kaula_field(10, seed=5, amplitude=1e-4),
+        kaula_field(60, seed=6),
+        kaula_field(400, seed=7),
+    ]
+
+
+def _points(radius):
+    rng = np.random.default_rng(11)
+    u = rng.normal(size=(12, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    pts = u * radius * rng.uniform(1.01, 1.6, size=(12, 1))
+    special = radius * np.array(
+        [
+            [0.0, 0.0, 1.1],  # north pole
+            [0.0, 0.0, -1.05],  # south pole
+            [1e-9, 0.0, 1.2],  # next to a pole
+            [3e-4, -2e-4, -1.02],
+            [1.1, 0.0, 0.0],  # equator, on the axes
+            [0.0, -1.3, 0.0],
+        ]
+    )
+    return np.vstack([pts, special])
+
+
+@pytest.mark.parametrize("field", _fields(), ids=lambda f: f"degree{f.degree}")
+def test_single_point_equals_batch_of_one_bit_for_bit(field):
+    for r in _points(field.radius):
+        one = r[None, :]
+        for central in (True, False):
+            a = field.acceleration(r, central=central)
+            assert a.shape == (3,) and a.dtype == np.float64
+            np.testing.assert_array_equal(a, field.acceleration(one, central=central)[0])
+            U = field.potential(r, central=central)
+            assert isinstance(U, float)
+            assert U == field.potential(one, central=central)[0]
+            H = field.hessian(r, central=central)
+            np.testing.assert_array_equal(H, field.hessian(one, central=central)[0])
+            ev = field.evaluate(r, potential=False, hessian=True, central=central)
+            assert ev.potential is None
+            np.testing.assert_array_equal(ev.acceleration, a)
+            np.testing.assert_array_equal(ev.hessian, H)
+            full = field.evaluate(r, hessian=True, central=central)
+            assert full.potential == U
+            np.testing.assert_array_equal(full.acceleration, a)
+            np.testing.assert_array_equal(full.hessian, H)
+
+
+def test_fast_path_leaves_the_input_alone_and_returns_a_new_array():
+    field = kaula_field(8, seed=3, amplitude=1e-4)
+    r = np.array([1.2e6, -0.9e6, 1.1e6])
+    keep = r.copy()
+    a = field.acceleration(r)
+    b = field.acceleration(r)
+    np.testing.assert_array_equal(r, keep)
+    assert a is not r and not np.shares_memory(a, r)
+    assert a is not b and not np.shares_memory(a, b)
+    assert a.flags.writeable and a.flags.c_contiguous
+    a[0] = 0.0  # the caller owns it
+    np.testing.assert_array_equal(field.acceleration(r), b)
+    ev = field.evaluate(r, potential=False, hessian=True)
+    np.testing.assert_array_equal(r, keep)
+    assert not np.shares_memory(ev.acceleration, r)
+    ro = r.copy()
+    ro.setflags(write=False)
+    np.testing.assert_array_equal(field.acceleration(ro), b)
+
+
+def test_inputs_that_take_the_general_path_give_the_same_numbers():
+    field = kaula_field(8, seed=3, amplitude=1e-4)
+    r = np.array([1_200_000.0, -900_000.0, 1_100_000.0])  # exact in every dtype below
+    ref = field.acceleration(r)
+    for other in (
+        [1_200_000.0, -900_000.0, 1_100_000.0],
+        (1_200_000, -900_000, 1_100_000),  # integers
+        r.astype(np.float32),
+        r.astype(">f8"),  # not native byte order
+        r.astype(object),
+        np.stack([r, r], axis=1)[:, 0],  # a non-contiguous view
+    ):
+        np.testing.assert_array_equal(field.acceleration(other), ref)
+        np.testing.assert_array_equal(
+            field.evaluate(other, potential=False, hessian=True).acceleration, ref
+        )
+        assert field.potential(other) == field.potential(r)
+
+
+def test_fast_path_errors_name_the_position_and_leave_the_input_alone():
+    field = kaula_field(300, seed=3)
+    bad = np.array([1e6, np.nan, 0.0])
+    with pytest.raises(NonFiniteError, match=r"r_F must be finite; got \[.*nan"):
+        field.acceleration(bad)
+    with pytest.raises(DomainError, match="is the origin"):
+        field.evaluate(np.zeros(3), potential=False, hessian=True)
+    inside = np.array([1.0, 2.0, 3.0])
+    with pytest.raises(DomainError, match=r"r_F = \[1\., 2\., 3\.\] m"):
+        field.acceleration(inside, central=False)
+    with pytest.raises(DomainError, match=r"r_F = \[1\., 2\., 3\.\] m"):
+        field.potential(inside)
+    np.testing.assert_array_equal(inside, [1.0, 2.0, 3.0])
+    with pytest.raises(ShapeError, match=r"got \(4,\)"):
+        field.acceleration(np.ones(4))  # float64, one dimension, but not a position
+
+
+def test_entry_falls_back_to_the_dispatcher():
+    class NotCompiled:
+        def __init__(self):
+            self.overloads = {}
+
+    k = NotCompiled()
+    assert _kernels.entry(k) is k
+    assert callable(_kernels.entry(_kernels.acceleration_at))
