@@ -65,6 +65,7 @@ __all__ = [
     "field_data",
     "offsets",
     "perturbation_acceleration_at",
+    "perturbation_acceleration_hessian_at",
     "perturbation_potential_at",
     "potential_at",
     "workspace_size",
@@ -700,10 +701,10 @@ def perturbation_potential_at(d, buf):  # type: ignore[no-untyped-def]
     return code
 
 
-@njit(types.int64(_RO, _RW, _RW2, types.int64), cache=True)
-def acceleration_hessian_at(d, buf, hess, mode):  # type: ignore[no-untyped-def]
-    """∇U written over ``buf`` and ∇∇U into ``hess`` (3, 3), in one pass (mode 6 or 14)."""
-    code, Q, o = _at(d, buf, (mode & 8) | 6)
+@njit(cache=True, inline="always")
+def _acceleration_hessian_at(d, buf, hess, mode):  # type: ignore[no-untyped-def]
+    """∇U written over ``buf`` and ∇∇U into ``hess`` (3, 3), in one pass."""
+    code, Q, o = _at(d, buf, mode)
     if code == OK:
         buf[0] = Q[o + 1]
         buf[1] = Q[o + 2]
@@ -718,6 +719,18 @@ def acceleration_hessian_at(d, buf, hess, mode):  # type: ignore[no-untyped-def]
         hess[2, 1] = Q[o + 8]
         hess[2, 2] = Q[o + 9]
     return code
+
+
+@njit(types.int64(_RO, _RW, _RW2), cache=True)
+def acceleration_hessian_at(d, buf, hess):  # type: ignore[no-untyped-def]
+    """∇U (m/s²) written over ``buf`` and ∇∇U (1/s²) into ``hess`` (3, 3), in one pass."""
+    return _acceleration_hessian_at(d, buf, hess, np.int64(6))
+
+
+@njit(types.int64(_RO, _RW, _RW2), cache=True)
+def perturbation_acceleration_hessian_at(d, buf, hess):  # type: ignore[no-untyped-def]
+    """:func:`acceleration_hessian_at` without the central term."""
+    return _acceleration_hessian_at(d, buf, hess, np.int64(14))
 
 
 def entry(kernel: Any) -> Any:

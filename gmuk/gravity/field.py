@@ -35,6 +35,9 @@ _perturbation_acceleration_at = _kernels.entry(_kernels.perturbation_acceleratio
 _potential_at = _kernels.entry(_kernels.potential_at)
 _perturbation_potential_at = _kernels.entry(_kernels.perturbation_potential_at)
 _acceleration_hessian_at = _kernels.entry(_kernels.acceleration_hessian_at)
+_perturbation_acceleration_hessian_at = _kernels.entry(
+    _kernels.perturbation_acceleration_hessian_at
+)
 
 # mode bits of the kernel
 _POT = 1
@@ -50,6 +53,8 @@ _new_values = tuple.__new__  # FieldValues without the NamedTuple constructor's 
 _array = np.array  # np.array(r_F): always a new array, so the kernel may write into it
 _F64 = np.dtype(np.float64)
 _SHAPE3 = (3,)
+_SHAPE33 = (3, 3)
+_empty = np.empty
 
 _NORMALIZATIONS = ("4pi", "unnormalized")
 
@@ -520,6 +525,21 @@ class SphericalHarmonicField:
         FieldValues
             ``(potential, acceleration, hessian)``, ``None`` for what was not requested.
         """
+        if hessian and acceleration and not potential:
+            # the usual request of rigid-body gravity: a fast path for one position
+            try:
+                r = _array(r_F)
+            except (TypeError, ValueError):
+                r = _NO_OUT
+            if r.dtype is _F64 and r.shape == _SHAPE3:
+                H = _empty(_SHAPE33)
+                if central:
+                    code = _acceleration_hessian_at(self._data, r, H)
+                else:
+                    code = _perturbation_acceleration_hessian_at(self._data, r, H)
+                if not code:
+                    return _new_values(FieldValues, (None, r, H))
+                raise self._failure(code, r)
         mode = (_POT if potential else 0) | (_ACC if acceleration else 0)
         mode |= _HES if hessian else 0
         if not mode:
@@ -531,12 +551,6 @@ class SphericalHarmonicField:
         except (TypeError, ValueError):
             r = _points(r_F)
         if r.dtype is _F64 and r.shape == _SHAPE3:
-            if mode == _ACC | _HES:  # the usual request of rigid-body gravity (fast path)
-                H = np.empty((3, 3))
-                code = _acceleration_hessian_at(self._data, r, H, 6 if central else 14)
-                if code:
-                    raise self._failure(code, r)
-                return _new_values(FieldValues, (None, r, H))
             out = np.empty(_STRIDE[mode])
             H = np.empty((3, 3)) if mode & _HES else _NO_HESS
             code = _evaluate(self._data, r, out, H, mode if central else mode | _NO_CENTRAL)

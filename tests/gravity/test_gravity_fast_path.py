@@ -122,8 +122,15 @@ def test_fast_path_errors_name_the_position_and_leave_the_input_alone():
     with pytest.raises(DomainError, match=r"r_F = \[1\., 2\., 3\.\] m"):
         field.potential(inside)
     np.testing.assert_array_equal(inside, [1.0, 2.0, 3.0])
+    for method in (field.acceleration, field.potential):
+        with pytest.raises(ShapeError, match=r"got \(4,\)"):
+            method(np.ones(4))  # float64, one dimension, but not a position
     with pytest.raises(ShapeError, match=r"got \(4,\)"):
-        field.acceleration(np.ones(4))  # float64, one dimension, but not a position
+        field.evaluate(np.ones(4), potential=False, hessian=True)
+    with pytest.raises(ShapeError, match="could not convert"):
+        field.evaluate(["a", "b", "c"], potential=False, hessian=True)
+    with pytest.raises(NonFiniteError, match="r_F must be finite"):
+        field.evaluate([np.inf, 0.0, 1e6], potential=False, hessian=True, central=False)
 
 
 def test_entry_falls_back_to_the_dispatcher():
