@@ -122,6 +122,7 @@ def breakdown() -> None:
     import timeit
 
     from gmuk import _uk_kernels
+    from gmuk._numba import entry
 
     J = np.diag([3.0e4, 3.2e4, 3.4e4])
     body = gmuk.RigidBody("a", 15103.0, J)
@@ -131,13 +132,15 @@ def breakdown() -> None:
     st = S.state(g={"a": np.eye(4)}, V={"a": ref.xi})
     A, b = S._stack_rows(st, check_finite=False)
     z = S._zero_loads
-    args = (st.V, z, A, b, S._J, S._Jinv, S._m_rigid, S._Minv_sqrt, S._M_dense, 1e8, 1e-8)
+    args = (st.V, z, A, b, S._uk_params, np.empty(4 * 6 + 6 + 3))
+    compiled = entry(_uk_kernels.uk_rigid_c)
     parts = [
         ("System.accelerations (whole call)", lambda: S.accelerations(st)),
         ("reference.evaluate (the user's)", lambda: ref.evaluate(0.3)),
         ("ConfigurationTracking.rows (incl. evaluate)", lambda: c.rows(st)),
         ("rows + checks (System._stack_rows)", lambda: S._stack_rows(st, check_finite=False)),
-        ("compiled solve (uk_rigid)", lambda: _uk_kernels.uk_rigid(*args)),
+        ("compiled solve, numba dispatcher (uk_rigid)", lambda: _uk_kernels.uk_rigid(*args)),
+        ("compiled solve, compiled entry (uk_rigid_c)", lambda: compiled(*args)),
     ]
     for label, fn in parts:
         t = min(timeit.repeat(fn, number=5000, repeat=9)) / 5000

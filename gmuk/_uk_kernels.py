@@ -1,9 +1,21 @@
-"""Compiled kernels for the System's hot path (free accelerations, dense UK solve)."""
+"""Compiled kernels for the System's hot path (free accelerations, dense UK solve).
+
+:func:`uk_rigid_c` has one explicit signature so that the System can call its compiled
+function through :func:`gmuk._numba.entry`, without numba's dispatcher (which resolves the
+types of its arguments on every call). Such a call does not check its arguments: they must
+be exactly the declared types (float64, C-contiguous, the declared dimensions), or the
+kernel reads memory wrongly. The System checks that before it takes this path and calls the
+generic :func:`uk_rigid` otherwise.
+"""
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+
+_RO1 = types.Array(types.float64, 1, "C", readonly=True)
+_RO2 = types.Array(types.float64, 2, "C", readonly=True)
+_RW1 = types.Array(types.float64, 1, "C")
 
 
 @njit(cache=True)
@@ -81,9 +93,15 @@ def _mul4(A: np.ndarray, B: np.ndarray, out: np.ndarray) -> None:
 
 @njit(cache=True)
 def tracking_b(
-    g: np.ndarray, V: np.ndarray, gd: np.ndarray, Vd: np.ndarray, Vd_dot: np.ndarray
-) -> np.ndarray:
-    """b of Eq. 67, projected: se(3) part of g⁻¹ g_d (V_d^² + V̇_d^) − V^² as a twist.
+    g: np.ndarray,
+    V: np.ndarray,
+    gd: np.ndarray,
+    Vd: np.ndarray,
+    Vd_dot: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """b of Eq. 67, projected: se(3) part of g⁻¹ g_d (V_d^² + V̇_d^) − V^² as a twist,
+    written into ``out`` (6,).
 
     Explicit 4×4 loops: BLAS calls on such small matrices cost more than the arithmetic.
     """
@@ -107,14 +125,12 @@ def tracking_b(
     _mul4(T2, T1, Hd)  # g⁻¹ g_d (V_d^² + V̇_d^)
     _hat4(V, H)
     _mul4(H, H, T1)  # V^²
-    out = np.empty(6)
     out[0] = 0.5 * ((Hd[2, 1] - T1[2, 1]) - (Hd[1, 2] - T1[1, 2]))
     out[1] = 0.5 * ((Hd[0, 2] - T1[0, 2]) - (Hd[2, 0] - T1[2, 0]))
     out[2] = 0.5 * ((Hd[1, 0] - T1[1, 0]) - (Hd[0, 1] - T1[0, 1]))
     out[3] = Hd[0, 3] - T1[0, 3]
     out[4] = Hd[1, 3] - T1[1, 3]
     out[5] = Hd[2, 3] - T1[2, 3]
-    return out
 
 
 @njit(cache=True)
@@ -263,12 +279,7 @@ def uk_qr(
     return ac, lam, residual, scale, status
 
 
-@njit(cache=True)
-def uk_rigid(
-    V: np.ndarray,
-    Q: np.ndarray,
-    A: np.ndarray,
-    b: np.ndarray,
+def rigid_params(
     J: np.ndarray,
     Jinv: np.ndarray,
     m: np.ndarray,
@@ -277,18 +288,43 @@ def uk_rigid(
     cond_limit: float,
     consistency_tol: float,
 ) -> np.ndarray:
-    """One call for a dense all-rigid System whose loads the UK solve all sees.
+    """The constant arguments of :func:`uk_rigid` packed in one read-only vector:
+    ``[cond_limit, consistency_tol, J (9 n_b), J⁻¹ (9 n_b), m (n_b), M^{-1/2} (n²), M (n²)]``
+    for n_b rigid bodies and n = 6 n_b (one argument to unbox instead of seven)."""
+    P = np.concatenate(
+        [
+            [float(cond_limit), float(consistency_tol)],
+            np.ravel(J),
+            np.ravel(Jinv),
+            np.ravel(m),
+            np.ravel(Minv_sqrt),
+            np.ravel(M),
+        ]
+    ).astype(np.float64)
+    P.setflags(write=False)
+    return P
 
-    Free accelerations (Eq. 10b) under the modeled wrenches Q (n,), the QR solve of
-    :func:`_qr_solve`, the constraint wrenches M ν̇_c and the total, packed in one array
-    (one allocation and one boxed return instead of six: that dominates at n = 6):
-    ``[a (n), ν̇_c (n), total (n), M ν̇_c (n), λ (s), residual, scale, status]``, with status
-    3 when solved but ``residual > consistency_tol · scale`` (the caller warns or raises).
-    """
+
+@njit(cache=True, inline="always")
+def _uk_rigid(
+    V: np.ndarray, Q: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, out: np.ndarray
+) -> None:
     n = A.shape[1]
     s = A.shape[0]
-    out = np.zeros(4 * n + s + 3)
-    a = rigid_free_accel(V, J, Jinv, m, Q.reshape(-1, 6)).reshape(-1)
+    nb = n // 6
+    cond_limit = P[0]
+    consistency_tol = P[1]
+    o = 2
+    J = P[o : o + 9 * nb].reshape((nb, 3, 3))
+    o += 9 * nb
+    Jinv = P[o : o + 9 * nb].reshape((nb, 3, 3))
+    o += 9 * nb
+    m = P[o : o + nb]
+    o += nb
+    Minv_sqrt = P[o : o + n * n].reshape((n, n))
+    o += n * n
+    M = P[o : o + n * n].reshape((n, n))
+    a = rigid_free_accel(V, J, Jinv, m, Q.reshape((nb, 6))).reshape(-1)
     ac = out[n : 2 * n]
     residual, scale, status = _qr_solve(A, b, a, Minv_sqrt, cond_limit, ac, out[4 * n : 4 * n + s])
     for r in range(n):
@@ -303,7 +339,34 @@ def uk_rigid(
     if status == 0 and residual > consistency_tol * scale:
         status = 3
     out[4 * n + s + 2] = status
-    return out
+
+
+@njit(cache=True)
+def uk_rigid(
+    V: np.ndarray, Q: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, out: np.ndarray
+) -> None:
+    """One call for a dense all-rigid System whose loads the UK solve all sees.
+
+    Free accelerations (Eq. 10b) of the twists V (n_b, 6) under the modeled wrenches Q (n,),
+    the QR solve of :func:`_qr_solve` of A (s, n) ν̇ = b, the constraint wrenches M ν̇_c and
+    the total, written into ``out`` (4n + s + 3,): ``[a (n), ν̇_c (n), total (n), M ν̇_c (n),
+    λ (s), residual, scale, status]``, with status 3 when solved but ``residual >
+    consistency_tol · scale`` (the caller warns or raises); the other entries are
+    meaningful only for status 0 and 3. P from :func:`rigid_params`. Any array layout.
+
+    The caller allocates ``out``: a numba kernel that returns a new array pays ≈ 0.5 µs per
+    call to box it (it unpickles the array's dtype each time; numba 0.68), several times
+    what ``np.empty`` costs in Python.
+    """
+    _uk_rigid(V, Q, A, b, P, out)
+
+
+@njit(types.void(_RO2, _RO1, _RO2, _RO1, _RO1, _RW1), cache=True)
+def uk_rigid_c(
+    V: np.ndarray, Q: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, out: np.ndarray
+) -> None:
+    """:func:`uk_rigid` for C-contiguous float64 arrays (called through ``gmuk._numba.entry``)."""
+    _uk_rigid(V, Q, A, b, P, out)
 
 
 @njit(cache=True)
@@ -314,13 +377,17 @@ def relative_rows(
     V_B: np.ndarray,
     S: np.ndarray,
     a_des: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    A: np.ndarray,
+    b: np.ndarray,
+    Vr: np.ndarray,
+) -> None:
     """Rows of a relative-twist constraint (McCann 2020, Eq. 73 and Section 4.1.3).
 
     With h = g_{B/L}⁻¹ = g_B⁻¹ g_L (R_h = R_Bᵀ R_L, p_h = R_Bᵀ (p_L − p_B)),
     Ad_h = [[R_h, 0], [p_h^ R_h, R_h]], W = Ad_h V_L and V_{B/L} = V_B − W:
     ``A = [−S Ad_h, S]`` and ``b = S (a_des − ad_{V_{B/L}} W)``, with
-    ``ad_V W = [ω × ω_W; v × ω_W + ω × v_W]``. Returns (A (s, 12), b (s,), V_{B/L} (6,)).
+    ``ad_V W = [ω × ω_W; v × ω_W + ω × v_W]``. Writes A (s, 12), b (s,) and V_{B/L} (6,)
+    into the arrays given.
     """
     Rh = np.empty((3, 3))
     d = np.empty(3)
@@ -347,7 +414,6 @@ def relative_rows(
         for k in range(6):
             acc += Ad[i, k] * V_L[k]
         W[i] = acc
-    Vr = np.empty(6)
     for i in range(6):
         Vr[i] = V_B[i] - W[i]
     w0, w1, w2, v0, v1, v2 = Vr[0], Vr[1], Vr[2], Vr[3], Vr[4], Vr[5]
@@ -360,8 +426,6 @@ def relative_rows(
     r[4] = a_des[4] - (v2 * x0 - v0 * x2 + w2 * y0 - w0 * y2)
     r[5] = a_des[5] - (v0 * x1 - v1 * x0 + w0 * y1 - w1 * y0)
     s = S.shape[0]
-    A = np.empty((s, 12))
-    b = np.empty(s)
     for i in range(s):
         acc_b = 0.0
         for j in range(6):
@@ -372,4 +436,3 @@ def relative_rows(
             A[i, 6 + j] = S[i, j]
             acc_b += S[i, j] * r[j]
         b[i] = acc_b
-    return A, b, Vr

@@ -24,6 +24,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from gmuk import _uk_kernels, uk
+from gmuk._numba import entry
 from gmuk._validation import FloatArray, all_finite, as_array, check_se3
 from gmuk.bodies import Body, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
@@ -53,6 +54,9 @@ SPARSE_THRESHOLD = 300
 QR_MAX_ROWS = 48
 QR_COND_LIMIT = 1e8
 _EPS = float(np.finfo(float).eps)
+_F64 = np.dtype(np.float64)
+_empty = np.empty
+_uk_rigid_c = entry(_uk_kernels.uk_rigid_c)
 
 
 @dataclass(frozen=True, eq=False)
@@ -223,6 +227,17 @@ class System:
         self._fused = not (
             self.sparse or self.tangent_bundle or self._plant_only_loads or self.layout.n_euclid
         ) and bool(self.constraints)
+        if self._fused:
+            self._V_shape = (self.layout.n_rigid, 6)
+            self._uk_params = _uk_kernels.rigid_params(
+                self._J,
+                self._Jinv,
+                self._m_rigid,
+                self._Minv_sqrt,
+                self._M_dense,
+                self._qr_cond_limit,
+                self.consistency_tol,
+            )
 
     # ------------------------------------------------------------------ validation
     def _validate(self) -> list[str]:
@@ -608,20 +623,19 @@ class System:
         if self._fused:
             rows = A, b = self._stack_rows(state, check_finite=False)
             if 0 < b.size <= QR_MAX_ROWS:
-                out = _uk_kernels.uk_rigid(
-                    state.V,
-                    modeled,
-                    A,
-                    b,
-                    self._J,
-                    self._Jinv,
-                    self._m_rigid,
-                    self._Minv_sqrt,
-                    self._M_dense,
-                    self._qr_cond_limit,
-                    self.consistency_tol,
-                )
+                V = state.V
                 n, s = A.shape[1], b.size
+                out = _empty(4 * n + s + 3)
+                if (
+                    V.dtype == _F64  # (not "is": arrays made by numba carry their own dtype object)
+                    and V.shape == self._V_shape
+                    and V.flags.c_contiguous
+                    and A.flags.c_contiguous
+                    and b.flags.c_contiguous
+                ):  # exactly the declared types: the compiled entry, no dispatch
+                    _uk_rigid_c(V, modeled, A, b, self._uk_params, out)
+                else:
+                    _uk_kernels.uk_rigid(V, modeled, A, b, self._uk_params, out)
                 status = float(out[-1])
                 if status == 3.0:
                     self._check_consistency(state, float(out[-3]), float(out[-2]))

@@ -158,7 +158,108 @@ def test_compiled_relative_rows_equal_eq_73_written_with_the_lie_operators(seed)
         Ad_inv = se3.Ad(se3.inverse(g_BL))
         A_ref = np.hstack([-S @ Ad_inv, S])
         b_ref = S @ (a_des - se3.ad(V_BL) @ AdV_L)
-        A, b, V_rel = _uk_kernels.relative_rows(g_L, V_L, g_B, V_B, S, a_des)
+        A, b, V_rel = np.full((5, 12), np.nan), np.full(5, np.nan), np.full(6, np.nan)
+        _uk_kernels.relative_rows(g_L, V_L, g_B, V_B, S, a_des, A, b, V_rel)
         assert np.allclose(A, A_ref, rtol=0, atol=1e-13 * np.abs(A_ref).max())
         assert np.allclose(b, b_ref, rtol=0, atol=1e-13 * max(1.0, np.abs(b_ref).max()))
         assert np.allclose(V_rel, V_BL, rtol=0, atol=1e-13 * np.abs(V_BL).max())
+
+
+def _values(acc):
+    return np.concatenate([acc.free, acc.constraint, acc.total, acc.constraint_force])
+
+
+def _count_entry_calls(monkeypatch):
+    calls = []
+    entry = gmuk.system._uk_rigid_c
+
+    def counted(*args):
+        calls.append(1)
+        entry(*args)
+
+    monkeypatch.setattr(gmuk.system, "_uk_rigid_c", counted)
+    return calls
+
+
+def test_rows_in_any_memory_layout_give_the_results_of_contiguous_rows(monkeypatch):
+    # Fortran-ordered or strided rows cannot take the compiled entry (it assumes C order);
+    # the System must notice and take the dispatcher, with bit-identical numbers.
+    calls = _count_entry_calls(monkeypatch)
+    rng = np.random.default_rng(8)
+    bodies = random_rigid_bodies(rng, 2)
+    A, b = rng.normal(size=(7, 12)), rng.normal(size=7)
+    variants = {
+        "C": (A, b),
+        "Fortran A": (np.asfortranarray(A), b),
+        "strided": (np.repeat(A, 2, axis=1)[:, ::2], np.repeat(b, 2)[::2]),
+    }
+    results = {}
+    for label, (Ai, bi) in variants.items():
+        system = gmuk.System(bodies, [Rows(bodies, Ai, bi)])
+        assert system._fused
+        state = random_state(system, np.random.default_rng(9))
+        n_before = len(calls)
+        results[label] = _values(system.accelerations(state))
+        assert len(calls) - n_before == (1 if label == "C" else 0), label
+    assert np.array_equal(results["C"], results["Fortran A"])
+    assert np.array_equal(results["C"], results["strided"])
+
+
+def test_twists_in_any_memory_layout_give_the_results_of_contiguous_twists(monkeypatch):
+    calls = _count_entry_calls(monkeypatch)
+    rng = np.random.default_rng(10)
+    bodies = random_rigid_bodies(rng, 2)
+    system = gmuk.System(bodies, [Rows(bodies, rng.normal(size=(5, 12)), rng.normal(size=5))])
+    state = random_state(system, rng)
+    strided = np.repeat(state.V, 2, axis=0)[::2]  # same values, every other row in memory
+    assert not strided.flags.c_contiguous
+    x = system.accelerations(state)
+    y = system.accelerations(state.replace(V=strided))
+    assert calls == [1]  # the contiguous state only
+    assert np.array_equal(_values(x), _values(y))
+
+
+class _ListReference(ReferenceTrajectory):
+    """A reference giving plain lists (converted by the constraint)."""
+
+    def __init__(self, inner):
+        self.inner = inner
+
+    def evaluate(self, t):
+        r = self.inner.evaluate(t)
+        return ReferenceState(r.g.tolist(), r.V.tolist(), r.V_dot.tolist())
+
+
+def test_tracking_reference_as_lists_gives_the_rows_of_arrays():
+    rng = np.random.default_rng(11)
+    (body,) = random_rigid_bodies(rng, 1)
+    ref = ScrewReference(np.eye(4), np.array([0.01, -0.02, 0.03, 1.0, 2.0, -0.5]))
+    arrays = gmuk.System([body], [gmuk.ConfigurationTracking(body, ref)])
+    lists = gmuk.System([body], [gmuk.ConfigurationTracking(body, _ListReference(ref))])
+    state = random_state(arrays, rng).replace(t=1.5)
+    A1, b1 = arrays.constraint_rows(state)
+    A2, b2 = lists.constraint_rows(state)
+    assert np.array_equal(A1, A2) and np.array_equal(b1, b2)
+
+
+def test_one_tracking_constraint_in_two_systems_uses_each_systems_index():
+    # The constraint remembers its body's index per layout; alternating between Systems
+    # where the body sits at different indices must not mix them up.
+    rng = np.random.default_rng(12)
+    other, body = random_rigid_bodies(rng, 2)
+    ref = ScrewReference(np.eye(4), np.array([0.01, -0.02, 0.03, 1.0, 2.0, -0.5]))
+    c = gmuk.ConfigurationTracking(body, ref)
+    alone = gmuk.System([body], [c])
+    pair = gmuk.System([other, body], [c])
+    s1 = random_state(alone, rng).replace(t=0.7)
+    s2 = pair.state(
+        g={other.name: np.eye(4), body.name: s1.g[0]},
+        V={other.name: rng.normal(size=6), body.name: s1.V[0]},
+        t=0.7,
+    )
+    b_alone = alone.constraint_rows(s1)[1]
+    for _ in range(2):
+        A2, b2 = pair.constraint_rows(s2)
+        assert np.array_equal(b2, b_alone)
+        assert np.array_equal(A2[:, 6:], np.eye(6)) and not A2[:, :6].any()
+        assert np.array_equal(alone.constraint_rows(s1)[1], b_alone)

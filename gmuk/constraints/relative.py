@@ -121,8 +121,10 @@ class RelativeConstraint(Constraint):
                     f"constraint {self.name!r}: acceleration(t) returned shape {a_des.shape}; "
                     "expected (6,)"
                 )
-        A, b, V_BL = _uk_kernels.relative_rows(
-            state.pose(L), state.twist(L), state.pose(B), state.twist(B), self.S, a_des
+        s = self.S.shape[0]  # outputs allocated here: cheaper than arrays returned by numba
+        A, b, V_BL = np.empty((s, 12)), np.empty(s), np.empty(6)
+        _uk_kernels.relative_rows(
+            state.pose(L), state.twist(L), state.pose(B), state.twist(B), self.S, a_des, A, b, V_BL
         )
         if self.baumgarte is not None:
             v_des = (

@@ -112,7 +112,9 @@ def exp(xi: Any) -> FloatArray:
     """
     if type(xi) is np.ndarray and xi.shape == (6,) and xi.dtype == np.float64:
         if all_finite(xi):  # one element, the common case: no reshaping round trip
-            return _kernels.se3_exp(xi.reshape(1, 6))[0]
+            g = np.empty((4, 4))
+            _kernels._se3_exp(xi, g)
+            return g
     return _exp(as_array(xi, (6,), "xi"))
 
 
