@@ -263,3 +263,23 @@ def test_one_tracking_constraint_in_two_systems_uses_each_systems_index():
         assert np.array_equal(b2, b_alone)
         assert np.array_equal(A2[:, 6:], np.eye(6)) and not A2[:, :6].any()
         assert np.array_equal(alone.constraint_rows(s1)[1], b_alone)
+
+
+def test_one_relative_constraint_in_two_systems_uses_each_systems_indices():
+    rng = np.random.default_rng(13)
+    L, B, other = random_rigid_bodies(rng, 3)
+    c = gmuk.RelativeConstraint(B, L, free_axes=[0])
+    first = gmuk.System([L, B], [c])
+    second = gmuk.System([B, other, L], [c])  # the two bodies elsewhere, in another order
+    s1 = random_state(first, rng)
+    s2 = second.state(
+        g={B.name: s1.g[1], other.name: np.eye(4), L.name: s1.g[0]},
+        V={B.name: s1.V[1], other.name: rng.normal(size=6), L.name: s1.V[0]},
+    )
+    A1, b1 = first.constraint_rows(s1)
+    for _ in range(2):
+        A2, b2 = second.constraint_rows(s2)
+        assert np.array_equal(b2, b1)
+        assert np.array_equal(A2[:, 12:], A1[:, :6]) and np.array_equal(A2[:, :6], A1[:, 6:])
+        assert not A2[:, 6:12].any()
+        assert np.array_equal(first.constraint_rows(s1)[1], b1)

@@ -105,13 +105,20 @@ class RelativeConstraint(Constraint):
         if S.ndim != 2 or S.shape[1] != 6 or not np.isfinite(S).all():
             raise ConstraintError(f"S must be a finite (s, 6) matrix; got shape {S.shape}")
         self.S = S
+        self._cached_index: tuple[object, int, int] = (None, 0, 0)
         self.acceleration = acceleration
         self.velocity = velocity
         self.baumgarte = baumgarte
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) with columns [V_L, V_B]."""
-        L, B = self.bodies
+        cached_layout, iL, iB = self._cached_index  # the bodies' indices, once per layout
+        if state.layout is not cached_layout:
+            L, B = self.bodies
+            iL = state._slot(L, "rigid", "pose").index
+            iB = state._slot(B, "rigid", "pose").index
+            # one tuple, set in one step: a constraint shared across Systems stays coherent
+            object.__setattr__(self, "_cached_index", (state.layout, iL, iB))
         if self.acceleration is None:
             a_des = _ZERO6
         else:
@@ -124,7 +131,7 @@ class RelativeConstraint(Constraint):
         s = self.S.shape[0]  # outputs allocated here: cheaper than arrays returned by numba
         A, b, V_BL = np.empty((s, 12)), np.empty(s), np.empty(6)
         _uk_kernels.relative_rows(
-            state.pose(L), state.twist(L), state.pose(B), state.twist(B), self.S, a_des, A, b, V_BL
+            state.g[iL], state.V[iL], state.g[iB], state.V[iB], self.S, a_des, A, b, V_BL
         )
         if self.baumgarte is not None:
             v_des = (
