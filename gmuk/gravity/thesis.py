@@ -21,7 +21,7 @@ compared with the correct model.
   radial) the whole harmonic effect. Measured with GRGM660PRIM to degree 150 (4π P̄) at
   2000 random points 100 km above the reference sphere: ``|a_eq25 − a| / |a − a_central|``
   has median 1.51 (5–95 %: 1.01–1.96), RMS error / RMS perturbation 1.63; the tangential
-  part carries 45 % of the perturbation's energy (median |a_t|/|a_pert| = 0.76); with
+  part carries 45 % of the perturbation's energy (median ``|a_t|/|a_pert|`` = 0.76); with
   degree 2 only: median 1.59, RMS ratio 1.66. (The errata's "97–99 % tangential, error
   about twice the harmonic effect" is not what these measurements give; the bound 1–2× is
   exact.) With the Eq. 26c normalisation as well the perturbation is wrong by many orders
