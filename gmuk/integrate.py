@@ -15,7 +15,10 @@ Methods
 ``"DOP853"`` (default)
     Dormand–Prince 8(5,3) with error control and a 7th-order continuous extension for
     output times (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.10; coefficients
-    from ``scipy.integrate._ivp.dop853_coefficients``).
+    from ``scipy.integrate._ivp.dop853_coefficients``). A step with output times inside it
+    is accepted only if the continuous extension also meets the tolerance, estimated from
+    its defect (one more evaluation per such step): RKMK's step ends are often far more
+    accurate than the extension between them, which the step-end estimate cannot see.
 ``"DOPRI5"``
     Dormand–Prince 5(4) (Dormand & Prince 1980), stepping exactly onto output times.
 ``"RK4"``
@@ -155,14 +158,26 @@ class _Problem:
     def scale(
         self, Y0: FloatArray, Y1: FloatArray, G0: FloatArray, rtol: float, atol: float
     ) -> FloatArray:
-        """Error weights: ξ's rotation part against 1 rad, its translation against ‖r‖."""
+        """Error weights, one per entry of Y (the larger of the values at both ends).
+
+        Rigid bodies are weighted by 3-vector norms, so that the weights do not depend on
+        how the inertial or body axes are chosen: ξ's rotation part against 1 rad, its
+        translation part (body-frame components) against the distance ‖r‖ of the base pose,
+        the twist's ω against ‖ω‖ and its v against ‖v‖. Euclidean coordinates and
+        controller states are weighted component by component.
+        """
         sc = atol + rtol * np.maximum(np.abs(Y0), np.abs(Y1))
         if self.nr:
-            r = np.abs(G0[:, :3, 3])
-            xi_sc = np.empty((self.nr, 6))
-            xi_sc[:, :3] = atol + rtol
-            xi_sc[:, 3:] = atol + rtol * r
+            r = np.linalg.norm(G0[:, :3, 3], axis=1)
+            xi_sc = np.empty((self.nr, 2, 3))
+            xi_sc[:, 0] = atol + rtol
+            xi_sc[:, 1] = (atol + rtol * r)[:, None]
             sc[self.s_xi] = xi_sc.ravel()
+            V = np.maximum(
+                np.linalg.norm(Y0[self.s_V].reshape(-1, 2, 3), axis=2),
+                np.linalg.norm(Y1[self.s_V].reshape(-1, 2, 3), axis=2),
+            )
+            sc[self.s_V] = np.repeat(atol + rtol * V, 3)
         return sc
 
     def advance_base(self, Y: FloatArray, G0: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -281,7 +296,9 @@ def simulate(
     method : {"DOP853", "DOPRI5", "RK4"}
     rtol, atol : float
         Relative and absolute tolerances (adaptive methods). Error weights use the distance
-        ``‖r‖`` (m) for the translational part of ξ and 1 rad for its rotational part.
+        ``‖r‖`` (m) for the translational part of ξ, 1 rad for its rotational part and the
+        norms ``‖ω‖``, ``‖v‖`` for the twist, so they do not depend on the choice of axes.
+        With DOP853 and ``t_eval``, they bound the error of the interpolated outputs too.
     step : float
         Step size (s) for RK4 (required there); ignored otherwise.
     first_step, max_step : float, optional
@@ -345,6 +362,37 @@ def simulate(
     finally:
         bar.close()
     return rec.build(status, message, stepper.stats())
+
+
+#: Where the continuous extension's defect is sampled, and the factor taking its norm to a
+#: bound on the extension's error (see ``_Stepper._dense_error``).
+_DEFECT_NODE, _DEFECT_GAIN = 0.95, 0.18
+
+
+class _Interpolant:
+    """u(s) = Y₀ + s(F₀ + (1−s)(F₁ + s(F₂ + …))), s = (t − t₀)/h: DOP853's dense output."""
+
+    def __init__(self, t: float, h: float, Y0: FloatArray, F: FloatArray) -> None:
+        self.t, self.h, self.Y0, self.F = t, h, Y0, F
+
+    def __call__(self, tt: float) -> FloatArray:
+        s = (tt - self.t) / self.h
+        out = np.zeros(self.Y0.size)
+        for i, Fi in enumerate(self.F[::-1]):
+            out = (out + Fi) * (s if i % 2 == 0 else 1.0 - s)
+        return self.Y0 + out
+
+    def value_and_derivative(self, s: float) -> tuple[FloatArray, FloatArray]:
+        """u(s) and du/ds."""
+        out = np.zeros(self.Y0.size)
+        dout = np.zeros(self.Y0.size)
+        for i, Fi in enumerate(self.F[::-1]):
+            q = out + Fi
+            if i % 2 == 0:
+                out, dout = q * s, dout * s + q
+            else:
+                out, dout = q * (1.0 - s), dout * (1.0 - s) - q
+        return self.Y0 + out, dout
 
 
 class _StepFailure(RuntimeError):
@@ -444,7 +492,7 @@ class _Stepper:
         K: FloatArray,
         Y1: FloatArray,
         f1: FloatArray,
-    ) -> Any:
+    ) -> _Interpolant:
         """DOP853 continuous extension on [t, t + h] in the local coordinates."""
         d = self.dop853
         n = d.N_STAGES
@@ -459,15 +507,27 @@ class _Stepper:
         F[1] = h * K[0] - dY
         F[2] = 2.0 * dY - h * (f1 + K[0])
         F[3:] = h * (d.D @ Kx)
+        return _Interpolant(t, h, Y, F)
 
-        def at(tt: float) -> FloatArray:
-            s = (tt - t) / h
-            out = np.zeros(Y.size)
-            for i, Fi in enumerate(F[::-1]):
-                out = (out + Fi) * (s if i % 2 == 0 else 1.0 - s)
-            return Y + out
+    def _dense_error(self, interp: _Interpolant, G0: FloatArray, Y1: FloatArray) -> float:
+        """Estimated maximum error of the continuous extension over the step, in the norm
+        of the step error (≤ 1: within tolerance). One right-hand-side evaluation.
 
-        return at
+        The extension u(s), s ∈ [0, 1], has order 7: its error is
+        e(s) = h⁸ Σ_τ e_τ(s) F(τ)(y₀) + O(h⁹) over the trees τ of order 8, and its defect
+        δ(s) = h f(u(s)) − u′(s) = e′(s) + O(h e). The defect is sampled at s* = 0.95, near
+        where the e_τ′ peak. For every one of the 115 trees, max|e_τ| / |e_τ′(s*)| lies
+        between 0.112 and 0.179 with DOP853's coefficients, so 0.18 ‖δ(s*)‖ bounds the
+        error of any single elementary differential. (Sampling the defect is the idea of
+        defect control: W. H. Enright, "A new error-control for initial value solvers",
+        Appl. Math. Comput. 31 (1989); here the defect serves as an error estimate.)
+        """
+        s_star = _DEFECT_NODE
+        u, du = interp.value_and_derivative(s_star)
+        f = self.p(interp.t + s_star * interp.h, u, G0)[0]
+        sc = self.p.scale(interp.Y0, Y1, G0, self.rtol, self.atol)
+        dev = (interp.h * f - du) / sc
+        return _DEFECT_GAIN * float(np.sqrt(dev @ dev / sc.size))
 
     def run(
         self,
@@ -518,12 +578,19 @@ class _Stepper:
                 h_next = h
             t_new = t + h_try
             if outs is not None and self.method == "DOP853":
-                hit = outs[out_i:][outs[out_i:] <= t_new]
+                hit = outs[out_i:][outs[out_i:] < t_new]
                 if hit.size:
+                    # Output times inside the step: the continuous extension must meet the
+                    # tolerance as well, or the step is retried shorter.
                     interp = self._dense(t, Y, G0, h_try, K, Y1, f1)
+                    err_d = self._dense_error(interp, G0, Y1)
+                    factor_d = 0.9 * (max(err_d, 1e-10) ** (-1.0 / self.tab.order))
+                    if err_d > 1.0:
+                        self.n_rejected += 1
+                        h = h_try * max(0.2, min(0.9, factor_d))
+                        continue
+                    h_next = min(h_next, h_try * min(10.0, max(0.2, factor_d)))
                     for tt in hit:
-                        if tt == t_new:
-                            continue
                         st = p.state(float(tt), interp(float(tt)), G0)
                         rec.add(st)
                         out_i += 1
