@@ -20,6 +20,9 @@ A, B     ``L(M)`` each     recursion coefficients ``a_nm``, ``b_nm`` of the norm
                            entry ``n = m`` of ``A`` holds the sectoral factor ``k_m``
 f, F     ``M + 2`` each    ``f_n = √((2n+1)/(2n+3))`` and ``F_n = f_n f_{n+1}``
 h, G     ``2M + 8`` each   ``h_k = √k`` and ``G_k = √(k(k+1))``
+w⁰,w⁺,w⁻ ``L(N)`` each     weights of the gradient sums, packed as C (only up to
+         (none above       degree ``WEIGHTED``): ``w⁰_nm = f_n h_{n+m+1} h_{n-m+1}``,
+         ``WEIGHTED``)     ``w⁺_nm = f_n G_{n+m+1}``, ``w⁻_nm = f_n G_{n-m+1}``
 ======== ================= ===========================================================
 
 with ``L(N) = (N+1)(N+2)/2``.
@@ -27,6 +30,14 @@ with ``L(N) = (N+1)(N+2)/2``.
 Indices inside the loops are unsigned (``uint64``) so that no negative-index wraparound
 test is compiled into them (numba adds one for signed indices, which costs about a third
 of the time of these loops and prevents vectorisation).
+
+The gradient weights are products of f, h and G entries, stored so that the gradient
+sums, the bulk of an acceleration, do four multiplications fewer per term (computed in
+the order the sums multiply the factors otherwise; the accelerations checked did not
+change by a bit). Above
+degree ``WEIGHTED`` they are left out and the sums multiply the factors themselves: the
+three extra vectors would more than double the memory a call streams through, and at
+degree 660 that cost more time than the multiplications it saves.
 
 Workspace
 ---------
@@ -36,6 +47,9 @@ one more than the highest degree of solid harmonic needed: eight solid-harmonic 
 (real parts, then imaginary parts) and ten results (U, ∇U, and the upper triangle of the
 Hessian, row by row). :func:`evaluate` loops over points with one workspace; the
 ``*_at`` kernels are the single-point entries used by the public single-point calls.
+Workspaces of up to :data:`STACK_FLOATS` floats (degree ≤ 61 whatever the request) live
+on the stack of the calling kernel, larger ones on the heap (allocating and releasing
+one cost ≈ 50–70 ns per call, about what the whole degree-0 series costs).
 
 Calling without numba's dispatcher
 ----------------------------------
@@ -52,12 +66,17 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit, types, uint64
+from llvmlite import ir
+from numba import carray, njit, types, uint64
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from gmuk._validation import FloatArray
 
 __all__ = [
     "HEADER",
+    "STACK_FLOATS",
+    "WEIGHTED",
     "acceleration_at",
     "acceleration_hessian_at",
     "entry",
@@ -73,6 +92,9 @@ __all__ = [
 
 #: Length of the header of the field data vector.
 HEADER = 8
+
+#: Highest degree whose data vector holds the gradient weights (see the module docstring).
+WEIGHTED = 100
 
 #: Mantissa range of the extended-exponent ("X-number") arithmetic: values are kept as
 #: mantissa · BIG^e with the mantissa renormalised into [BIG⁻¹, BIG) when it leaves it.
@@ -113,7 +135,11 @@ def _col(m: int, n: int) -> int:
 
 
 def offsets(N: int) -> tuple[int, int, int, int, int, int, int, int, int]:
-    """Section offsets (C, S, A, B, f, F, h, G) and total length of a degree-N data vector."""
+    """Section offsets (C, S, A, B, f, F, h, G) and total length of a degree-N data vector.
+
+    Up to degree ``WEIGHTED`` the gradient weights follow G: ``w⁰`` at ``oG + 2M + 8``,
+    then ``w⁺`` and ``w⁻``.
+    """
     M = N + 2
     L = (N + 1) * (N + 2) // 2
     LM = (M + 1) * (M + 2) // 2
@@ -126,7 +152,7 @@ def offsets(N: int) -> tuple[int, int, int, int, int, int, int, int, int]:
     oF = of + M + 2
     oh = oF + M + 2
     oG = oh + nh
-    return oC, oS, oA, oB, of, oF, oh, oG, oG + nh
+    return oC, oS, oA, oB, of, oF, oh, oG, oG + nh + (3 * L if N <= WEIGHTED else 0)
 
 
 def field_data(mu: float, radius: float, C: FloatArray, S: FloatArray) -> FloatArray:
@@ -185,10 +211,43 @@ def field_data(mu: float, radius: float, C: FloatArray, S: FloatArray) -> FloatA
     d[of:oF] = f
     d[oF : oF + M + 1] = f[:-1] * f[1:]
     k = np.arange(oG - oh, dtype=float)
-    d[oh:oG] = np.sqrt(k)
-    d[oG:size] = np.sqrt(k * (k + 1))
+    h = np.sqrt(k)
+    G = np.sqrt(k * (k + 1))
+    d[oh:oG] = h
+    oW = oG + len(k)
+    d[oG:oW] = G
+    if N <= WEIGHTED:
+        _gradient_weights(d, N, oW, f, h, G)
+    d = _numba_owned(d)
     d.setflags(write=False)
     return d
+
+
+@njit(_RW(_RW), cache=True)
+def _numba_owned(a):  # type: ignore[no-untyped-def]
+    """A copy of ``a`` allocated by numba.
+
+    numba passes such an array to a compiled function as is; for any other array it
+    allocates a wrapper on every call and frees it afterwards (≈ 20 ns of a single-point
+    call, the data vector being an argument of every one).
+    """
+    return a.copy()
+
+
+def _gradient_weights(
+    d: FloatArray, N: int, oW: int, f: FloatArray, h: FloatArray, G: FloatArray
+) -> None:
+    """Write w⁰, w⁺, w⁻ into ``d`` from ``oW`` on (packed as C, multiplied in the order
+    :func:`_gradient_sums` multiplies the factors)."""
+    L = (N + 1) * (N + 2) // 2
+    rows, cols = np.tril_indices(N + 1)
+    order = np.lexsort((rows, cols))
+    n_ = rows[order]
+    m_ = cols[order]
+    fn = f[n_]
+    d[oW : oW + L] = fn * h[n_ + m_ + 1] * h[n_ - m_ + 1]
+    d[oW + L : oW + 2 * L] = fn * G[n_ + m_ + 1]
+    d[oW + 2 * L : oW + 3 * L] = fn * G[n_ - m_ + 1]
 
 
 @njit(cache=True)
@@ -284,6 +343,40 @@ def _gradient_sums(d, oc, os_, of, oha, ohb, oga, ogb, Q, q0, qp, qm, L):  # typ
 
 
 @njit(cache=True, fastmath=_SUMS)
+def _weighted_gradient_sums(d, oc, os_, ow0, owp, owm, Q, q0, qp, qm, L):  # type: ignore[no-untyped-def]
+    """Sums of one coefficient column against solid-harmonic columns m, m±1, weighted by
+    w⁰, w⁺, w⁻ (see the module docstring)."""
+    zc = 0.0
+    zs = 0.0
+    pc = 0.0
+    ps = 0.0
+    mc = 0.0
+    ms = 0.0
+    bc = uint64(oc)
+    bs = uint64(os_)
+    b0w = uint64(ow0)
+    bpw = uint64(owp)
+    bmw = uint64(owm)
+    b0 = uint64(q0)
+    bp = uint64(qp)
+    bm = uint64(qm)
+    for i in range(L):
+        k = uint64(i)
+        c = d[bc + k]
+        s = d[bs + k]
+        t = d[b0w + k] * Q[b0 + k]
+        zc += t * c
+        zs += t * s
+        t = d[bpw + k] * Q[bp + k]
+        pc += t * c
+        ps += t * s
+        t = d[bmw + k] * Q[bm + k]
+        mc += t * c
+        ms += t * s
+    return zc, zs, pc, ps, mc, ms
+
+
+@njit(cache=True, fastmath=_SUMS)
 def _hessian_sums(d, oc, os_, oF, oha, ohb, oga, ogb, Q, q0, qp, qpp, qm, qmm, L):  # type: ignore[no-untyped-def]
     """Weighted sums of one coefficient column against solid-harmonic columns m, m±1, m±2."""
     xc = 0.0
@@ -364,6 +457,7 @@ def _point(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
     oF = of + M + 2
     oh = oF + M + 2
     oG = oh + 2 * M + 8
+    oW = oG + 2 * M + 8  # gradient weights w⁰, w⁺, w⁻ (up to degree WEIGHTED)
     W = Mc + 1
     W8 = 8 * W  # the seeds σ follow the eight columns: real parts, imaginary parts
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
@@ -465,11 +559,17 @@ def _point(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
             pot += uc * s0r + us * s0i
         if want_a:
             k1 = n0 + 1
-            zc, zs, pc, ps, mc, ms = _gradient_sums(
-                d, oC + cofs, oS + cofs, of + n0,
-                oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
-                Q, q0 + k1, qp + k1, qm + k1, Lm,
-            )  # fmt: skip
+            if N <= WEIGHTED:
+                zc, zs, pc, ps, mc, ms = _weighted_gradient_sums(
+                    d, oC + cofs, oS + cofs, oW + cofs, oW + L + cofs, oW + 2 * L + cofs,
+                    Q, q0 + k1, qp + k1, qm + k1, Lm,
+                )  # fmt: skip
+            else:
+                zc, zs, pc, ps, mc, ms = _gradient_sums(
+                    d, oC + cofs, oS + cofs, of + n0,
+                    oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
+                    Q, q0 + k1, qp + k1, qm + k1, Lm,
+                )  # fmt: skip
             gz += zc * s0r + zs * s0i
             if m == 0:
                 pc *= ISQRT2
@@ -579,11 +679,40 @@ def workspace_size(N: int, mode: int) -> int:
     return 8 * (N + lead + 1) + 26
 
 
+#: Largest workspace taken on the stack (floats; 4.3 kB): degree 61 with the Hessian.
+STACK_FLOATS = 8 * 64 + 26
+
+
+@intrinsic
+def _stack_floats(typingctx):  # type: ignore[no-untyped-def]
+    """Pointer to STACK_FLOATS float64 reserved on the stack of the calling function.
+
+    The space belongs to the compiled function this call ends up in (it is allocated in
+    that function's entry block, once, however often the call executes), so only
+    ``inline="always"`` helpers may use it on their caller's behalf, and nothing made from
+    it may outlive that function's call.
+    """
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        return cgutils.alloca_once(builder, ir.DoubleType(), size=STACK_FLOATS)
+
+    return types.CPointer(types.float64)(), codegen
+
+
 @njit(cache=True, inline="always")
 def _workspace(N, mode):  # type: ignore[no-untyped-def]
-    """A workspace for :func:`_point` (seed section zeroed) and the offset of its results."""
+    """A workspace for :func:`_point` (seed section zeroed) and the offset of its results.
+
+    On the stack of the kernel this is inlined into when it is small enough (see
+    :data:`STACK_FLOATS`), on the heap otherwise. Either way every call has a workspace
+    of its own (a stack frame is per call and per thread), so concurrent or nested calls
+    cannot share one.
+    """
     size = workspace_size(N, mode)
-    Q = np.empty(size)
+    if size <= STACK_FLOATS:
+        Q = carray(_stack_floats(), size)
+    else:
+        Q = np.empty(size)
     Q[size - 26 :] = 0.0
     return Q, size - 10
 

@@ -141,3 +141,38 @@ def test_entry_falls_back_to_the_dispatcher():
     k = NotCompiled()
     assert _kernels.entry(k) is k
     assert callable(_kernels.entry(_kernels.acceleration_at))
+
+
+def _padded(field, N):
+    """The same field written with degree N > field.degree (zero coefficients above)."""
+    C = np.zeros((N + 1, N + 1))
+    S = np.zeros((N + 1, N + 1))
+    n = field.degree + 1
+    C[:n, :n] = field.C
+    S[:n, :n] = field.S
+    return type(field)(field.mu, field.radius, C, S)
+
+
+@pytest.mark.parametrize(
+    "N",
+    [
+        (_kernels.STACK_FLOATS - 26) // 8 - 3,  # largest degree whose workspaces all fit
+        _kernels.WEIGHTED,  # largest degree with stored gradient weights
+    ],
+)
+def test_degrees_on_either_side_of_the_kernel_thresholds_agree(N):
+    # One more degree crosses to a heap workspace (with the Hessian) or to gradient sums
+    # that multiply their weights themselves; the numbers must not notice beyond round-off.
+    low = kaula_field(N, seed=9, amplitude=1e-4)
+    high = _padded(low, N + 1)
+    if N != _kernels.WEIGHTED:
+        assert _kernels.workspace_size(N, 6) <= _kernels.STACK_FLOATS
+        assert _kernels.workspace_size(N + 1, 6) > _kernels.STACK_FLOATS
+    for r in _points(low.radius):
+        a = low.acceleration(r)
+        np.testing.assert_allclose(high.acceleration(r), a, rtol=1e-14, atol=0)
+        np.testing.assert_array_equal(high.acceleration(r[None, :])[0], high.acceleration(r))
+        ev, evh = (f.evaluate(r, potential=False, hessian=True) for f in (low, high))
+        scale = np.abs(ev.hessian).max()
+        np.testing.assert_allclose(evh.hessian, ev.hessian, rtol=0, atol=1e-14 * scale)
+        np.testing.assert_allclose(high.potential(r), low.potential(r), rtol=1e-15)
