@@ -63,7 +63,6 @@ C-contiguous, the declared number of dimensions). :mod:`gmuk.gravity.field` does
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from llvmlite import ir
@@ -71,6 +70,7 @@ from numba import carray, njit, types, uint64
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from gmuk._numba import entry  # re-exported: field.py calls kernels through it
 from gmuk._validation import FloatArray
 
 __all__ = [
@@ -860,17 +860,3 @@ def acceleration_hessian_at(d, buf, hess):  # type: ignore[no-untyped-def]
 def perturbation_acceleration_hessian_at(d, buf, hess):  # type: ignore[no-untyped-def]
     """:func:`acceleration_hessian_at` without the central term."""
     return _acceleration_hessian_at(d, buf, hess, np.int64(14))
-
-
-def entry(kernel: Any) -> Any:
-    """The compiled function of a single-signature kernel, callable without dispatch.
-
-    Falls back to the dispatcher itself if numba does not expose the compiled function.
-    The caller must pass exactly the declared argument types (see the module docstring).
-    """
-    overloads = list(getattr(kernel, "overloads", {}).values())
-    if len(overloads) == 1:
-        fn = getattr(overloads[0], "entry_point", None)
-        if callable(fn):
-            return fn
-    return kernel

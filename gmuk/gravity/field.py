@@ -26,7 +26,7 @@ from gmuk.gravity import _kernels
 __all__ = ["FieldValues", "SphericalHarmonicField"]
 
 #: The compiled kernels, called without numba's type dispatch (see
-#: :func:`gmuk.gravity._kernels.entry`): every call below passes float64, C-contiguous arrays
+#: :func:`gmuk._numba.entry`): every call below passes float64, C-contiguous arrays
 #: of the declared number of dimensions (positions pass through :func:`_points` or are a
 #: fresh copy checked to be float64 of shape (3,)).
 _evaluate = _kernels.entry(_kernels.evaluate)
