@@ -400,7 +400,7 @@ class SphericalHarmonicField:
 
     # ------------------------------------------------------------------ evaluation
 
-    def potential(self, r_F: Any, *, central: bool = True) -> float | FloatArray:
+    def potential(self, r_F: Any, central: bool = True) -> float | FloatArray:
         """Gravitational potential U at body-fixed positions (m²/s²; U > 0, a = +∇U).
 
         Parameters
@@ -429,7 +429,10 @@ class SphericalHarmonicField:
             return float(buf[0])
         return self._batch(_points(r_F), _POT, central).potential  # type: ignore[return-value]
 
-    def acceleration(self, r_F: Any, *, central: bool = True) -> FloatArray:
+    # ``central`` of potential/acceleration/hessian is positional-or-keyword, not keyword-only:
+    # CPython fills keyword-only defaults on a slower path, ≈ 35–90 ns a call here, a tenth of
+    # a degree-10 single-point evaluation (benchmarks/README.md, Gravity).
+    def acceleration(self, r_F: Any, central: bool = True) -> FloatArray:
         """Gravitational acceleration ∇U (full gradient) at body-fixed positions.
 
         Parameters
@@ -467,7 +470,7 @@ class SphericalHarmonicField:
             return buf
         return self._batch(_points(r_F), _ACC, central).acceleration  # type: ignore[return-value]
 
-    def hessian(self, r_F: Any, *, central: bool = True) -> FloatArray:
+    def hessian(self, r_F: Any, central: bool = True) -> FloatArray:
         """Gravity-gradient tensor ∇∇U at body-fixed positions (1/s², frame F).
 
         Parameters

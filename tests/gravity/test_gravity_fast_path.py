@@ -176,3 +176,13 @@ def test_degrees_on_either_side_of_the_kernel_thresholds_agree(N):
         scale = np.abs(ev.hessian).max()
         np.testing.assert_allclose(evh.hessian, ev.hessian, rtol=0, atol=1e-14 * scale)
         np.testing.assert_allclose(high.potential(r), low.potential(r), rtol=1e-15)
+
+
+def test_central_may_be_given_by_position_or_by_keyword():
+    field = kaula_field(10, seed=5, amplitude=1e-4)
+    r = np.array([1.2e6, -0.9e6, 1.0e6])
+    for central in (True, False):
+        for method in (field.acceleration, field.hessian):
+            np.testing.assert_array_equal(method(r, central), method(r, central=central))
+        assert field.potential(r, central) == field.potential(r, central=central)
+    assert not np.array_equal(field.acceleration(r, False), field.acceleration(r))
