@@ -26,7 +26,13 @@ def pair_summary(pair: Any, fcei: Any, orbit: Any) -> dict[str, Any]:
     acc_a, acc_b = a.constraint_acceleration[:, 3:], b.constraint_acceleration[:, 3:]
     pos, _ = common.reference_errors(pair, orbit, "virtual")
     return {
-        "max_relative_locked_components": float(np.abs(rel[:, 1:]).max()),
+        # the five locked components of log(g_L⁻¹ g_B), by unit: rotations about axes 2, 3
+        # (rad) and the translation (m; its floor is the round-off of |r| ≈ 4e6 m)
+        "max_locked_rotation_rad": float(np.abs(rel[:, 1:3]).max()),
+        "max_locked_translation_m": float(np.abs(rel[:, 3:]).max()),
+        "max_locked_translation_over_distance": float(
+            np.abs(rel[:, 3:]).max() / np.linalg.norm(pair.body("virtual").position, axis=1).max()
+        ),
         "max_abs_roll_rad": float(np.abs(rel[:, 0]).max()),
         "translational_constraint_accel_rel_diff_vs_fcei": float(
             np.abs(acc_a - acc_b).max() / np.abs(acc_b).max()

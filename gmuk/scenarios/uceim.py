@@ -66,7 +66,7 @@ def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
         "max_roll_difference_vs_ucei_rad": float(
             np.abs(common.relative_pose(t2)[:, 0] - common.relative_pose(r6)[:, 0]).max()
         ),
-        "max_relative_locked_components": float(np.abs(common.relative_pose(t2)[:, 1:3]).max()),
+        "max_locked_rotation_rad": float(np.abs(common.relative_pose(t2)[:, 1:3]).max()),
         "eq80_unreachable_fraction_min": float(min(unreachable)),
         "eq80_unreachable_fraction_max": float(max(unreachable)),
         "eq80_projected_constraint_accel_rel_error_max": float(max(gap)),
