@@ -85,6 +85,7 @@ class Constraint(FreezesInSystem, abc.ABC):
 
     _bodies: tuple[Body | str, ...]
     _name: str
+    _cached_indices: tuple[object, tuple[int, ...]] | None = None
 
     def __init__(self, bodies: Sequence[Body | str], *, name: str | None = None) -> None:
         if isinstance(bodies, str) or not isinstance(bodies, Sequence):
@@ -108,6 +109,17 @@ class Constraint(FreezesInSystem, abc.ABC):
     def name(self) -> str:
         """Label of the constraint."""
         return self._name
+
+    def _rigid_indices(self, state: State) -> tuple[int, ...]:
+        """Indices into ``state.g`` and ``state.V`` of :attr:`bodies` (all rigid), looked up
+        once per layout (a constraint shared by several Systems keeps the last one's)."""
+        cached = self._cached_indices
+        if cached is not None and cached[0] is state.layout:
+            return cached[1]
+        indices = tuple(state._slot(b, "rigid", "pose").index for b in self.bodies)
+        # one tuple, set in one step, so that layout and indices always belong together
+        object.__setattr__(self, "_cached_indices", (state.layout, indices))
+        return indices
 
     @abc.abstractmethod
     def rows(self, state: State) -> tuple[Any, Any]:

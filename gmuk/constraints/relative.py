@@ -105,20 +105,13 @@ class RelativeConstraint(Constraint):
         if S.ndim != 2 or S.shape[1] != 6 or not np.isfinite(S).all():
             raise ConstraintError(f"S must be a finite (s, 6) matrix; got shape {S.shape}")
         self.S = S
-        self._cached_index: tuple[object, int, int] = (None, 0, 0)
         self.acceleration = acceleration
         self.velocity = velocity
         self.baumgarte = baumgarte
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) with columns [V_L, V_B]."""
-        cached_layout, iL, iB = self._cached_index  # the bodies' indices, once per layout
-        if state.layout is not cached_layout:
-            L, B = self.bodies
-            iL = state._slot(L, "rigid", "pose").index
-            iB = state._slot(B, "rigid", "pose").index
-            # one tuple, set in one step: a constraint shared across Systems stays coherent
-            object.__setattr__(self, "_cached_index", (state.layout, iL, iB))
+        iL, iB = self._rigid_indices(state)
         if self.acceleration is None:
             a_des = _ZERO6
         else:

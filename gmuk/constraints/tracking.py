@@ -94,15 +94,10 @@ class ConfigurationTracking(Constraint):
             )
         self.reference = reference
         self.baumgarte = baumgarte
-        self._cached_index: tuple[object, int] = (None, 0)
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """A = I₆ and b of Eq. 67 (projected), plus Baumgarte terms."""
-        cached_layout, i = self._cached_index  # the body's index, looked up once per layout
-        if state.layout is not cached_layout:
-            i = state._slot(self.bodies[0], "rigid", "pose").index
-            # one tuple, set in one step: a constraint shared across Systems stays coherent
-            object.__setattr__(self, "_cached_index", (state.layout, i))
+        (i,) = self._rigid_indices(state)
         g, V = state.g[i], state.V[i]
         ref = self.reference.evaluate(state.t)
         gd, Vd, Vd_dot = ref.g, ref.V, ref.V_dot
