@@ -14,8 +14,9 @@ seeded). Points lie 50-500 km above the Moon (reference radius 1738 km).
 Single point, at one fixed position 200 km up:
 
 * gmuk ``field.acceleration(r_F)`` (a float64 array of shape (3,));
-* gmuk ``field.evaluate(r_F, potential=False, hessian=True)`` (acceleration and Hessian in
-  one pass);
+* gmuk ``field.acceleration_hessian(r_F)`` (acceleration and Hessian in one pass; the
+  ``acc + Hessian`` column and the ratio), and the same request through
+  ``field.evaluate(r_F, potential=False, hessian=True)`` (which calls it);
 * pyshtools ``pyshtools.gravmag.MakeGravGridPoint(cilm, gm, r0, r, lat, lon)`` with the
   spherical coordinates computed outside the timing, twice: with ``cilm`` a C-ordered
   array (``np.array([C, S])``, what ``SHCoeffs.coeffs`` is; f2py copies it into Fortran
@@ -27,8 +28,9 @@ Python loop of 1000 pyshtools calls (spherical coordinates precomputed).
 
 Per-call floor: what a compiled call from Python costs on this machine whatever the
 degree (an empty numba function with the signature of gmuk's single-point kernel, through
-numba's dispatcher and through the compiled entry gmuk uses; the array copy gmuk makes of
-its input), and both libraries at degree 0.
+numba's dispatcher and through the compiled entry gmuk uses; the allocation of the result
+array; ``np.array(r_F)``, the input copy gmuk made before 2026-11-23, for comparison), and
+both libraries at degree 0.
 
 Agreement: every row's gmuk acceleration is compared with pyshtools' (converted from
 (r, θ, φ) components to Cartesian, same sign convention a = +∇U) at 20 random points; the
@@ -142,12 +144,13 @@ def measure(cases: dict[str, object], repeat: int) -> dict[str, float]:
 
 
 _RO = types.Array(types.float64, 1, "C", readonly=True)
+_RA = types.Array(types.float64, 1, "A", readonly=True)
 _RW = types.Array(types.float64, 1, "C")
 
 
-@njit(types.int64(_RO, _RW))
-def _empty_kernel(d, buf):  # type: ignore[no-untyped-def]
-    """Does nothing; same signature as gmuk's single-point kernels."""
+@njit(types.int64(_RO, _RA, _RW, types.boolean))
+def _empty_kernel(d, r, out, central):  # type: ignore[no-untyped-def]
+    """Does nothing; same signature as gmuk's single-point acceleration kernel."""
     return 0
 
 
@@ -195,12 +198,13 @@ def main() -> None:
         mu, R = f.mu, f.radius
         # warm up (loads the compiled kernels) and check both libraries agree
         f.acceleration(r1)
-        f.evaluate(r1, potential=False, hessian=True)
+        f.acceleration_hessian(r1)
         err = agreement(f, cilm_f, check_pts)
         t = measure(
             {
                 "acc": lambda f=f: f.acceleration(r1),
-                "acc+H": lambda f=f: f.evaluate(r1, potential=False, hessian=True),
+                "acc+H": lambda f=f: f.acceleration_hessian(r1),
+                "evaluate acc+H": lambda f=f: f.evaluate(r1, potential=False, hessian=True),
                 "pysh C": lambda c=cilm_c, mu=mu, R=R: pysh.gravmag.MakeGravGridPoint(
                     c, mu, R, rn1, lat1, lon1
                 ),
@@ -222,7 +226,7 @@ def main() -> None:
     tb = measure(
         {
             "acc": lambda: f.acceleration(batch_pts),
-            "acc+H": lambda: f.evaluate(batch_pts, potential=False, hessian=True),
+            "acc+H": lambda: f.acceleration_hessian(batch_pts),
             "pysh C": lambda: [
                 pysh.gravmag.MakeGravGridPoint(cilm_c, mu, R, rn, la, lo)
                 for rn, la, lo in batch_sph
@@ -243,16 +247,17 @@ def main() -> None:
     cilm0 = np.asfortranarray(np.array([f0.C, f0.S]))
     # (``entry`` is absent before gmuk's single-point fast path; the row is then skipped)
     entry = getattr(_kernels, "entry", None)
-    buf = r1.copy()
-    _empty_kernel(d0, buf)
+    buf = np.empty(3)
+    _empty_kernel(d0, r1, buf, True)
     f0.acceleration(r1)
     floor = {
         "np.array(r_F)": lambda: np.array(r1),
-        "empty compiled call, numba dispatcher": lambda: _empty_kernel(d0, buf),
+        "np.empty(3)": lambda: np.empty(3),
+        "empty compiled call, numba dispatcher": lambda: _empty_kernel(d0, r1, buf, True),
     }
     if entry is not None:
         empty_entry = entry(_empty_kernel)
-        floor["empty compiled call, compiled entry"] = lambda: empty_entry(d0, buf)
+        floor["empty compiled call, compiled entry"] = lambda: empty_entry(d0, r1, buf, True)
     floor["gmuk acceleration, degree 0"] = lambda: f0.acceleration(r1)
     floor["pyshtools MakeGravGridPoint, degree 0"] = lambda: pysh.gravmag.MakeGravGridPoint(
         cilm0, mu, R, rn1, lat1, lon1
@@ -261,22 +266,23 @@ def main() -> None:
     print(f"load average at end: {os.getloadavg()[0]:.2f}\n")
 
     print(
-        "| degree | gmuk acceleration | gmuk acc + Hessian | (acc+H) / acc "
+        "| degree | gmuk acceleration | gmuk acc + Hessian | (acc+H) / acc | same via evaluate "
         "| pyshtools, C-ordered cilm | pyshtools, Fortran-ordered cilm "
         "| gmuk / faster pyshtools | Basilisk (issue) | max rel. diff. vs pyshtools |"
     )
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for N, t, err in rows:
         fast = min(t["pysh C"], t["pysh F"])
         print(
             f"| {N} | {fmt(t['acc'])} | {fmt(t['acc+H'])} | {t['acc+H'] / t['acc']:.2f} "
+            f"| {fmt(t['evaluate acc+H'])} "
             f"| {fmt(t['pysh C'])} | {fmt(t['pysh F'])} | {t['acc'] / fast:.2f} "
             f"| {fmt(BASILISK[N])} | {err:.1e} |"
         )
     fast = min(tb["pysh C"], tb["pysh F"])
     print(
         f"| 150, ×{BATCH} | {fmt(tb['acc'])} | {fmt(tb['acc+H'])} "
-        f"| {tb['acc+H'] / tb['acc']:.2f} | {fmt(tb['pysh C'])} (loop) "
+        f"| {tb['acc+H'] / tb['acc']:.2f} | — | {fmt(tb['pysh C'])} (loop) "
         f"| {fmt(tb['pysh F'])} (loop) | {tb['acc'] / fast:.2f} | — | — |"
     )
     print("\nPer-call floor (same run):\n")

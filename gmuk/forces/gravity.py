@@ -187,8 +187,12 @@ class SphericalHarmonicGravity(ForceModel):
             return m * (R_NF @ self.field.acceleration(r_F))
         J = body.inertia  # type: ignore[attr-defined]
         R_FB = R_FN @ g_NB[:3, :3]  # body components → F components
-        a_F = self.field.acceleration(r_F)
-        H_B = R_FB.T @ self.field.hessian(r_F) @ R_FB
+        both = getattr(self.field, "acceleration_hessian", None)  # one pass if the field can
+        if both is not None:
+            a_F, H_F = both(r_F)
+        else:
+            a_F, H_F = self.field.acceleration(r_F), self.field.hessian(r_F)
+        H_B = R_FB.T @ H_F @ R_FB
         JH = J @ H_B - H_B @ J
         L = np.array([JH[2, 1], JH[0, 2], JH[1, 0]])
         f_B = m * (R_FB.T @ a_F)

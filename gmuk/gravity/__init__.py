@@ -7,7 +7,8 @@ Public API
   ``.radius`` (m), ``.degree``, ``.C``, ``.S``, ``.truncate(n)``, and, at body-fixed
   positions ``r_F`` (m, shape (3,) or (k, 3)): ``potential`` (m²/s²), ``acceleration``
   (m/s², (3,) or (k, 3)), ``hessian`` (1/s², (3, 3) or (k, 3, 3)) and ``evaluate`` (any of
-  the three in one pass). ``central=False`` gives the perturbation only (every term but
+  the three in one pass; ``acceleration_hessian`` is the lean call for ∇U and ∇∇U
+  together). ``central=False`` gives the perturbation only (every term but
   C̄₀₀), which is what rigid-body force models add to their point-mass part.
 * :func:`load_gfc` (ICGEM ``.gfc``) and :func:`load_shadr` (PDS SHADR ``.tab``, GRAIL's
   archive format): readers returning a field in SI units; malformed files raise
@@ -77,10 +78,13 @@ cached on disk; 5-15 s on the first import on the project's shared 2-core machin
 from the cache afterwards). A field precomputes its recursion coefficients and
 square-root tables once, at construction or ``truncate``.
 
-Speed: a single position (a float64 array of shape (3,)) takes a fast path: one compiled
-call without numba's type dispatch, which writes the result over a copy of the input.
-Everything else (lists, other dtypes, batches) goes through the batch kernel; both run the
-same per-point code, so they agree bit for bit. Measured medians on the shared 2-core
+Speed: a single position given as a float64 array of shape (3,) (any strides) takes a
+fast path: one compiled call without numba's type dispatch, which reads the position where
+it lies and writes into a fresh result array. Everything else (lists, other dtypes,
+batches) goes through the batch kernel; both run the same per-point arithmetic, so they
+agree bit for bit (tested). Rigid-body gravity wants ∇U and ∇∇U at every step:
+``acceleration_hessian`` gives both from one pass, for 1.4–2.0× the cost of the
+acceleration alone. Measured medians on the shared 2-core
 machine, beside pyshtools 4.14 in the same run, are in ``benchmarks/README.md``
 (``python benchmarks/bench_gravity.py``).
 

@@ -26,18 +26,14 @@ from gmuk.gravity import _kernels
 __all__ = ["FieldValues", "SphericalHarmonicField"]
 
 #: The compiled kernels, called without numba's type dispatch (see
-#: :func:`gmuk._numba.entry`): every call below passes float64, C-contiguous arrays
-#: of the declared number of dimensions (positions pass through :func:`_points` or are a
-#: fresh copy checked to be float64 of shape (3,)).
+#: :func:`gmuk._numba.entry`): every call below passes float64 arrays of the declared
+#: number of dimensions, C-contiguous except the single-point position (positions pass
+#: through :func:`_points`, or are checked to be a float64 vector: the ``*_at`` entries
+#: check the length themselves).
 _evaluate = _kernels.entry(_kernels.evaluate)
 _acceleration_at = _kernels.entry(_kernels.acceleration_at)
-_perturbation_acceleration_at = _kernels.entry(_kernels.perturbation_acceleration_at)
 _potential_at = _kernels.entry(_kernels.potential_at)
-_perturbation_potential_at = _kernels.entry(_kernels.perturbation_potential_at)
 _acceleration_hessian_at = _kernels.entry(_kernels.acceleration_hessian_at)
-_perturbation_acceleration_hessian_at = _kernels.entry(
-    _kernels.perturbation_acceleration_hessian_at
-)
 
 # mode bits of the kernel
 _POT = 1
@@ -415,18 +411,13 @@ class SphericalHarmonicField:
         -------
         float or ndarray, shape (k,)
         """
-        try:
-            buf = _array(r_F)
-        except (TypeError, ValueError):
-            buf = _points(r_F)
-        if buf.dtype is _F64 and buf.shape == _SHAPE3:  # fast path: one point, in place
-            if central:
-                code = _potential_at(self._data, buf)
-            else:
-                code = _perturbation_potential_at(self._data, buf)
-            if code:
-                raise self._failure(code, buf)
-            return float(buf[0])
+        if _is_vector(r_F):  # fast path: one point
+            out = _empty(1)
+            code = _potential_at(self._data, r_F, out, central)
+            if not code:
+                return float(out[0])
+            if code > 0:
+                raise self._failure(code, r_F)
         return self._batch(_points(r_F), _POT, central).potential  # type: ignore[return-value]
 
     # ``central`` of potential/acceleration/hessian is positional-or-keyword, not keyword-only:
@@ -457,17 +448,16 @@ class SphericalHarmonicField:
             A position at the origin, or where the series does not give a finite value.
         """
         try:
-            buf = _array(r_F)
-        except (TypeError, ValueError):
-            buf = _points(r_F)
-        if buf.dtype is _F64 and buf.shape == _SHAPE3:  # fast path: one point, in place
-            if central:
-                code = _acceleration_at(self._data, buf)
-            else:
-                code = _perturbation_acceleration_at(self._data, buf)
-            if code:
-                raise self._failure(code, buf)
-            return buf
+            one = r_F.dtype is _F64 and r_F.ndim == 1  # fast path: one point
+        except AttributeError:  # a list, a tuple
+            one = False
+        if one:
+            out = _empty(3)
+            code = _acceleration_at(self._data, r_F, out, central)
+            if not code:
+                return out
+            if code > 0:
+                raise self._failure(code, r_F)
         return self._batch(_points(r_F), _ACC, central).acceleration  # type: ignore[return-value]
 
     def hessian(self, r_F: Any, central: bool = True) -> FloatArray:
@@ -497,6 +487,42 @@ class SphericalHarmonicField:
             return H
         return self._batch(_points(r_F), _HES, central).hessian  # type: ignore[return-value]
 
+    def acceleration_hessian(self, r_F: Any, central: bool = True) -> tuple[FloatArray, FloatArray]:
+        """Acceleration ∇U and gravity-gradient tensor ∇∇U in one pass over the coefficients.
+
+        What rigid-body gravity needs at every step (force and torque); the same numbers,
+        bit for bit, as :meth:`acceleration` and :meth:`hessian`, for less than the two
+        calls cost (measured in ``benchmarks/README.md``, Gravity).
+
+        Parameters
+        ----------
+        r_F : array_like, shape (3,) or (k, 3)
+            Position(s) in the body-fixed frame F (m).
+        central : bool
+            Include the central term (default) or return perturbations only.
+
+        Returns
+        -------
+        acceleration : ndarray, shape (3,) or (k, 3)
+            ∇U in frame F (m/s²).
+        hessian : ndarray, shape (3, 3) or (k, 3, 3)
+            ∇∇U in frame F (1/s²).
+        """
+        try:
+            one = r_F.dtype is _F64 and r_F.ndim == 1  # fast path: one point
+        except AttributeError:
+            one = False
+        if one:
+            a = _empty(3)
+            H = _empty(_SHAPE33)
+            code = _acceleration_hessian_at(self._data, r_F, a, H, central)
+            if not code:
+                return a, H
+            if code > 0:
+                raise self._failure(code, r_F)
+        v = self._batch(_points(r_F), _ACC | _HES, central)
+        return v.acceleration, v.hessian  # type: ignore[return-value]
+
     def evaluate(
         self,
         r_F: Any,
@@ -512,7 +538,7 @@ class SphericalHarmonicField:
         acceleration and Hessian together costs less than the two calls
         :meth:`acceleration` and :meth:`hessian` (measured ratios to the acceleration alone
         are in ``benchmarks/README.md``). A single position with ``potential=False,
-        acceleration=True, hessian=True`` takes a dedicated fast path.
+        acceleration=True, hessian=True`` is :meth:`acceleration_hessian`.
 
         Parameters
         ----------
@@ -528,21 +554,8 @@ class SphericalHarmonicField:
         FieldValues
             ``(potential, acceleration, hessian)``, ``None`` for what was not requested.
         """
-        if hessian and acceleration and not potential:
-            # the usual request of rigid-body gravity: a fast path for one position
-            try:
-                r = _array(r_F)
-            except (TypeError, ValueError):
-                r = _NO_OUT
-            if r.dtype is _F64 and r.shape == _SHAPE3:
-                H = _empty(_SHAPE33)
-                if central:
-                    code = _acceleration_hessian_at(self._data, r, H)
-                else:
-                    code = _perturbation_acceleration_hessian_at(self._data, r, H)
-                if not code:
-                    return _new_values(FieldValues, (None, r, H))
-                raise self._failure(code, r)
+        if hessian and acceleration and not potential:  # the rigid-body request
+            return _new_values(FieldValues, (None, *self.acceleration_hessian(r_F, central)))
         mode = (_POT if potential else 0) | (_ACC if acceleration else 0)
         mode |= _HES if hessian else 0
         if not mode:
@@ -656,6 +669,18 @@ def _coefficients(a: Any, name: str, label: str) -> FloatArray:
             f"({len(bad)} non-finite entr{'y' if len(bad) == 1 else 'ies'})"
         )
     return arr
+
+
+def _is_vector(r_F: Any) -> bool:
+    """Whether ``r_F`` is a float64 ndarray of one dimension (what the ``*_at`` entries take).
+
+    :meth:`SphericalHarmonicField.acceleration` has this test written out, to spare its
+    callers a function call.
+    """
+    try:
+        return r_F.dtype is _F64 and r_F.ndim == 1
+    except AttributeError:
+        return False
 
 
 def _points(r_F: Any) -> FloatArray:

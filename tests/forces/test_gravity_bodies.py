@@ -114,3 +114,29 @@ def test_spherical_harmonic_model_with_a_point_field_equals_eq_23():
 def test_spherical_harmonic_gravity_needs_a_field():
     with pytest.raises(gmuk.errors.DefinitionError, match="needs a CelestialBody with a field"):
         gmuk.forces.SphericalHarmonicGravity(gmuk.CelestialBody.moon())
+
+
+def test_harmonic_wrench_is_the_same_with_or_without_the_one_pass_field_call():
+    # SphericalHarmonicGravity takes ∇U and ∇∇U from one acceleration_hessian call when the
+    # field has it, and from acceleration() and hessian() otherwise (a duck-typed field):
+    # the same numbers either way.
+    field = gmuk.gravity.moon_low_degree()
+
+    class TwoCalls:
+        mu, radius, degree = field.mu, field.radius, field.degree
+        acceleration = staticmethod(field.acceleration)
+        hessian = staticmethod(field.hessian)
+
+    rot = gmuk.UniformRotation(2.66e-6)
+    one = gmuk.forces.SphericalHarmonicGravity(gmuk.CelestialBody("m", field=field, rotation=rot))
+    two = gmuk.forces.SphericalHarmonicGravity(
+        gmuk.CelestialBody("m", field=TwoCalls(), rotation=rot)
+    )
+    rng = np.random.default_rng(5)
+    body = gmuk.RigidBody("s", 1.5e4, np.diag([2.0e4, 3.0e4, 4.0e4]))
+    for t in (0.0, 3.0e4):
+        g = se3.exp(rng.normal(size=6))
+        g[:3, 3] *= 1.9e6 / np.linalg.norm(g[:3, 3])
+        np.testing.assert_array_equal(
+            one.wrench(t, g, np.zeros(6), body), two.wrench(t, g, np.zeros(6), body)
+        )

@@ -60,6 +60,9 @@ def test_single_point_equals_batch_of_one_bit_for_bit(field):
             assert U == field.potential(one, central=central)[0]
             H = field.hessian(r, central=central)
             np.testing.assert_array_equal(H, field.hessian(one, central=central)[0])
+            a2, H2 = field.acceleration_hessian(r, central)
+            np.testing.assert_array_equal(a2, a)
+            np.testing.assert_array_equal(H2, H)
             ev = field.evaluate(r, potential=False, hessian=True, central=central)
             assert ev.potential is None
             np.testing.assert_array_equal(ev.acceleration, a)
@@ -122,9 +125,10 @@ def test_fast_path_errors_name_the_position_and_leave_the_input_alone():
     with pytest.raises(DomainError, match=r"r_F = \[1\., 2\., 3\.\] m"):
         field.potential(inside)
     np.testing.assert_array_equal(inside, [1.0, 2.0, 3.0])
-    for method in (field.acceleration, field.potential):
-        with pytest.raises(ShapeError, match=r"got \(4,\)"):
-            method(np.ones(4))  # float64, one dimension, but not a position
+    for method in (field.acceleration, field.potential, field.acceleration_hessian):
+        for wrong in (np.ones(4), np.ones(2), np.ones(0)):
+            with pytest.raises(ShapeError, match=rf"got \({len(wrong)},\)"):
+                method(wrong)  # float64, one dimension, but not a position
     with pytest.raises(ShapeError, match=r"got \(4,\)"):
         field.evaluate(np.ones(4), potential=False, hessian=True)
     with pytest.raises(ShapeError, match="could not convert"):
@@ -186,3 +190,60 @@ def test_central_may_be_given_by_position_or_by_keyword():
             np.testing.assert_array_equal(method(r, central), method(r, central=central))
         assert field.potential(r, central) == field.potential(r, central=central)
     assert not np.array_equal(field.acceleration(r, False), field.acceleration(r))
+
+
+def test_float64_vectors_of_any_stride_read_in_place_give_the_same_numbers():
+    # The single-point entries read the caller's float64 vector where it lies (strided,
+    # reversed or read-only); the numbers are those of a contiguous copy, bit for bit.
+    field = kaula_field(12, seed=4, amplitude=1e-4)
+    r = np.array([1.2e6, -0.9e6, 1.1e6])
+    a, H = field.acceleration(r), field.hessian(r)
+    U = field.potential(r)
+    block = np.zeros((3, 4))
+    block[:, 2] = r
+    views = [
+        block[:, 2],  # a column: stride 32 bytes
+        r[::-1].copy()[::-1],  # negative stride
+        np.repeat(r, 3)[::3],
+    ]
+    ro = r.copy()
+    ro.setflags(write=False)
+    views.append(ro)
+    for v in views:
+        np.testing.assert_array_equal(v, r)
+        keep = v.copy()
+        np.testing.assert_array_equal(field.acceleration(v), a)
+        np.testing.assert_array_equal(field.acceleration_hessian(v)[1], H)
+        assert field.potential(v) == U
+        np.testing.assert_array_equal(v, keep)
+
+
+def test_central_flag_is_read_by_truth_value_on_every_path():
+    field = kaula_field(6, seed=2, amplitude=1e-4)
+    r = np.array([1.2e6, -0.9e6, 1.1e6])
+    one = r[None, :]
+    for flag in (True, False, 1, 0, np.bool_(True), np.bool_(False), None, 2.0):
+        want = bool(flag)
+        np.testing.assert_array_equal(field.acceleration(r, flag), field.acceleration(one, want)[0])
+        a, H = field.acceleration_hessian(r, flag)
+        np.testing.assert_array_equal(a, field.acceleration(one, want)[0])
+        np.testing.assert_array_equal(H, field.hessian(one, want)[0])
+        assert field.potential(r, flag) == field.potential(one, want)[0]
+
+
+def test_acceleration_hessian_of_batches_and_lists():
+    field = kaula_field(9, seed=8, amplitude=1e-4)
+    pts = _points(field.radius)
+    a, H = field.acceleration_hessian(pts)
+    assert a.shape == (len(pts), 3) and H.shape == (len(pts), 3, 3)
+    np.testing.assert_array_equal(a, field.acceleration(pts))
+    np.testing.assert_array_equal(H, field.hessian(pts))
+    a1, H1 = field.acceleration_hessian(list(pts[3]))
+    np.testing.assert_array_equal(a1, a[3])
+    np.testing.assert_array_equal(H1, H[3])
+    grid = pts[:6].reshape(2, 3, 3)
+    ag, Hg = field.acceleration_hessian(grid, central=False)
+    assert ag.shape == (2, 3, 3) and Hg.shape == (2, 3, 3, 3)
+    np.testing.assert_array_equal(ag.reshape(6, 3), field.acceleration(pts[:6], central=False))
+    a2, H2 = field.acceleration_hessian(pts[0])
+    assert not np.shares_memory(a2, H2) and a2.flags.writeable and H2.flags.writeable
