@@ -74,8 +74,10 @@ formed, so terms that matter are never lost to underflow. No factorials are form
 anywhere; every coefficient is a square root of a ratio of small integers.
 
 The kernels are compiled with numba (``gmuk.gravity._kernels``; explicit signatures,
-cached on disk; 5-15 s on the first import on the project's shared 2-core machine, loaded
-from the cache afterwards). A field precomputes its recursion coefficients and
+cached on disk): the first import compiles them, 25 s on the project's shared 2-core
+machine (``python -c "import gmuk.gravity.field"`` with an empty ``NUMBA_CACHE_DIR``, 20 s
+before the acceleration entries got their own inlined copies), and later imports load them
+from the cache (2 s for the whole import). A field precomputes its recursion coefficients and
 square-root tables once, at construction or ``truncate``.
 
 Speed: a single position given as a float64 array of shape (3,) (any strides) takes a
