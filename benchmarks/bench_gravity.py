@@ -29,8 +29,9 @@ Python loop of 1000 pyshtools calls (spherical coordinates precomputed).
 Per-call floor: what a compiled call from Python costs on this machine whatever the
 degree (an empty numba function with the signature of gmuk's single-point kernel, through
 numba's dispatcher and through the compiled entry gmuk uses; the allocation of the result
-array; ``np.array(r_F)``, the input copy gmuk made before 2026-11-23, for comparison), and
-both libraries at degree 0.
+array; ``np.array(r_F)``, the input copy gmuk made before 2026-11-23, for comparison),
+gmuk's compiled acceleration entry alone and the whole method at degrees 0 and 10, and
+pyshtools at degree 0.
 
 Agreement: every row's gmuk acceleration is compared with pyshtools' (converted from
 (r, θ, φ) components to Cartesian, same sign convention a = +∇U) at 20 random points; the
@@ -258,7 +259,16 @@ def main() -> None:
     if entry is not None:
         empty_entry = entry(_empty_kernel)
         floor["empty compiled call, compiled entry"] = lambda: empty_entry(d0, r1, buf, True)
+        acc_entry = entry(_kernels.acceleration_at)
+        d10 = fields[10]._data
+        floor["gmuk's compiled acceleration entry alone, degree 0"] = lambda: acc_entry(
+            f0._data, r1, buf, True
+        )
+        floor["gmuk's compiled acceleration entry alone, degree 10"] = lambda: acc_entry(
+            d10, r1, buf, True
+        )
     floor["gmuk acceleration, degree 0"] = lambda: f0.acceleration(r1)
+    floor["gmuk acceleration, degree 10"] = lambda: fields[10].acceleration(r1)
     floor["pyshtools MakeGravGridPoint, degree 0"] = lambda: pysh.gravmag.MakeGravGridPoint(
         cilm0, mu, R, rn1, lat1, lon1
     )
