@@ -83,9 +83,10 @@ square-root tables once, at construction or ``truncate``.
 Speed: a single position given as a float64 array of shape (3,) (any strides) takes a
 fast path: one compiled call without numba's type dispatch, which reads the position where
 it lies and writes into a fresh result array. Everything else (lists, other dtypes,
-batches) goes through the batch kernel; both run the same per-point arithmetic, so they
-agree bit for bit (tested). Rigid-body gravity wants ∇U and ∇∇U at every step:
-``acceleration_hessian`` gives both from one pass, for 1.4–2.0× the cost of the
+batches) goes through the batch kernel. Both run the same per-point code (compiled into
+each entry, the single-point ones with their request fixed) and the tests check that they
+agree bit for bit, across requests too (``acceleration`` and ``acceleration_hessian``). Rigid-body gravity wants ∇U and ∇∇U at every step:
+``acceleration_hessian`` gives both from one pass, for 1.4–2.1× the cost of the
 acceleration alone. Measured medians on the shared 2-core
 machine, beside pyshtools 4.14 in the same run, are in ``benchmarks/README.md``
 (``python benchmarks/bench_gravity.py``).
