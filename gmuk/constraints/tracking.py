@@ -117,6 +117,6 @@ class ConfigurationTracking(Constraint):
         b = _empty(6)  # filled by the kernel (cheaper than a kernel returning an array)
         _uk_kernels.tracking_b(g, V, gd, Vd, Vd_dot, b)
         if self.baumgarte is not None:
-            e_g, e_V = tracking_errors(g, V, ref.g, ref.V)
+            e_g, e_V = tracking_errors(g, V, gd, Vd)  # the checked float64 arrays
             b = b - self.baumgarte.alpha * e_V - self.baumgarte.beta * e_g
         return _EYE6, b

@@ -677,10 +677,10 @@ def _point_body(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
 _point = njit(cache=True)(_point_body)
 #: ... and inlined into the acceleration entries, each of which fixes every mode bit but
 #: the central-term one: LLVM then drops the potential and the unused derivative code
-#: (the entry's machine code shrinks from 3220 to 1890 lines). Called from Python, that
-#: took 0.11-0.23 us off a degree-10 call (medians, three runs), though a compiled loop
-#: over the two versions shows far less: a call from Python starts with cold caches and
-#: branch history, which favour smaller code.
+#: (the entry's machine code shrinks by about 40 %). Called from Python that made a
+#: degree-10 call faster, though a compiled loop over the two versions shows far less: a
+#: call from Python starts with cold caches and branch history, which favour smaller code
+#: (figures in benchmarks/README.md, Gravity).
 _point_inline = njit(cache=True, inline="always")(_point_body)
 
 

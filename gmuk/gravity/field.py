@@ -674,8 +674,8 @@ def _coefficients(a: Any, name: str, label: str) -> FloatArray:
 def _is_vector(r_F: Any) -> bool:
     """Whether ``r_F`` is a float64 ndarray of one dimension (what the ``*_at`` entries take).
 
-    :meth:`SphericalHarmonicField.acceleration` has this test written out, to spare its
-    callers a function call.
+    :meth:`SphericalHarmonicField.acceleration` and ``acceleration_hessian``, the calls of
+    propagation loops, have this test written out instead, to save a function call.
     """
     try:
         return r_F.dtype is _F64 and r_F.ndim == 1
