@@ -41,15 +41,25 @@ degree 660 that cost more time than the multiplications it saves.
 
 Workspace
 ---------
-:func:`_point` evaluates one point with a workspace of ``8 W + 26`` floats, ``W`` being
-one more than the highest degree of solid harmonic needed: eight solid-harmonic columns
-(a ring buffer indexed by ``m mod 8``, ``W`` values each), the eight column seeds σ
-(real parts, then imaginary parts) and ten results (U, ∇U, and the upper triangle of the
-Hessian, row by row). :func:`evaluate` loops over points with one workspace; the
-``*_at`` kernels are the single-point entries used by the public single-point calls.
-Workspaces of up to :data:`STACK_FLOATS` floats (degree ≤ 61 whatever the request) live
-on the stack of the calling kernel, larger ones on the heap (allocating and releasing
-one cost ≈ 50–70 ns per call, about what the whole degree-0 series costs).
+:func:`_point` evaluates one point in a workspace of ``(W + 2) K + 10`` floats, ``W``
+being one more than the highest degree of solid harmonic needed: ``K`` solid-harmonic
+columns of ``W`` values each, the ``K`` column seeds σ (real parts, then imaginary parts)
+and ten results (U, ∇U, and the upper triangle of the Hessian, row by row). Two layouts
+(:func:`layout`), with the same arithmetic in the same order (their results are equal bit
+for bit, as the tests check):
+
+* flat, for ``W ≤`` :data:`FLAT_WIDTH` (degree ≤ 61 whatever the request): ``K = W``, column
+  j in slot j; every column is made first, then every sum. One loop after the other
+  was 5-20 % faster than interleaving them (degrees 10-60, compiled loops;
+  ``benchmarks/README.md``, Gravity);
+* a ring above that: ``K = 8``, column j in slot ``j mod 8``, each column made when the
+  sums first need it, so that the workspace stays small at high degree.
+
+:func:`evaluate` loops over points with one workspace; the ``*_at`` kernels are the
+single-point entries used by the public single-point calls. Workspaces of up to
+:data:`STACK_FLOATS` floats (any flat one; a ring up to degree 523) live on the stack of
+the calling kernel, larger ones on the heap (allocating and releasing one cost ≈ 50–70 ns
+per call, about what the whole degree-0 series costs).
 
 Calling without numba's dispatcher
 ----------------------------------
@@ -75,6 +85,7 @@ from gmuk._numba import entry  # re-exported: field.py calls kernels through it
 from gmuk._validation import FloatArray
 
 __all__ = [
+    "FLAT_WIDTH",
     "HEADER",
     "NOT_ONE_POINT",
     "STACK_FLOATS",
@@ -84,6 +95,7 @@ __all__ = [
     "entry",
     "evaluate",
     "field_data",
+    "layout",
     "offsets",
     "potential_at",
     "workspace_size",
@@ -428,14 +440,62 @@ def _hessian_sums(d, oc, os_, oF, oha, ohb, oga, ogb, Q, q0, qp, qpp, qm, qmm, L
     return xc, xs, yc, ys, zc, zs, uc, us, vc, vs
 
 
-def _point_body(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
+@njit(cache=True, inline="always")
+def _advance_seed(kj, rho, s, t, sr, si, se):  # type: ignore[no-untyped-def]
+    """Seed σ_j = k_j ρ (s + i t) σ_{j-1} as a mantissa (sr, si) times BIG^se.
+
+    The mantissa is renormalised into [BIG⁻¹, 1) while the exponent is negative. Returns
+    ``(sr, si, se, vanished)``; ``vanished`` when σ_j is exactly zero (on the axis x = y = 0),
+    so is every later seed.
+    """
+    fr = kj * rho * s
+    fi = kj * rho * t
+    nr = fr * sr - fi * si
+    si = fr * si + fi * sr
+    sr = nr
+    mag = max(abs(sr), abs(si))
+    if mag == 0.0:
+        return sr, si, se, True
+    while mag < BIGI:
+        sr *= BIG
+        si *= BIG
+        mag *= BIG
+        se -= 1
+    while se < 0 and mag >= 1.0:
+        sr *= BIGI
+        si *= BIGI
+        mag *= BIGI
+        se += 1
+    return sr, si, se, False
+
+
+@njit(cache=True, inline="always")
+def _fill_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo, os_, K, sr, si, se):  # type: ignore[no-untyped-def]
+    """Column j (q_n, n = j..Mc, at ``Q[qo + n]``) and its seed σ_j as a plain float pair
+    at ``Q[os_]`` (real) and ``Q[os_ + K]`` (imaginary), the column's scalings folded in."""
+    e = se + _q_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo)
+    er = sr
+    ei = si
+    while e > 0:
+        er *= BIG
+        ei *= BIG
+        e -= 1
+    while e < 0:
+        er *= BIGI
+        ei *= BIGI
+        e += 1
+    Q[os_] = er
+    Q[os_ + K] = ei
+
+
+def _point_body(d, x, y, z, mode, Q, flat):  # type: ignore[no-untyped-def]
     """Values at one body-fixed point (x, y, z) (m), left in the workspace ``Q``.
 
-    ``mode`` as in :func:`evaluate`; ``Q`` of at least :func:`workspace_size` floats with
-    its seed section (``Q[8W : 8W + 16]``) zeroed. On success (status 0) the results are
-    ``Q[8W + 16]`` = U, ``Q[8W + 17 : 8W + 20]`` = ∇U and ``Q[8W + 20 : 8W + 26]`` =
-    (H_xx, H_xy, H_xz, H_yy, H_yz, H_zz), those requested by ``mode``. Otherwise the
-    status: 1 non-finite input, 2 the origin, 3 a non-finite result.
+    ``mode`` as in :func:`evaluate`; ``flat`` and the length of ``Q`` as given by
+    :func:`layout` (a ring's seed section, ``Q[8W : 8W + 16]``, zeroed). On success (status
+    0) the last ten floats of the workspace are U, ∇U and (H_xx, H_xy, H_xz, H_yy, H_yz,
+    H_zz), those requested by ``mode``. Otherwise the status: 1 non-finite input, 2 the
+    origin, 3 a non-finite result.
     """
     N = int(d[0])
     mu = d[1]
@@ -459,7 +519,9 @@ def _point_body(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
     oG = oh + 2 * M + 8
     oW = oG + 2 * M + 8  # gradient weights w⁰, w⁺, w⁻ (up to degree WEIGHTED)
     W = Mc + 1
-    W8 = 8 * W  # the seeds σ follow the eight columns: real parts, imaginary parts
+    K = W if flat else 8  # column slots
+    mask = -1 if flat else 7  # column j lives in slot j & mask
+    WK = K * W  # the seeds σ follow the columns: K real parts, then K imaginary parts
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
         return BAD_INPUT
     rn = math.sqrt(x * x + y * y + z * z)
@@ -491,75 +553,64 @@ def _point_body(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
     hpzi = 0.0
     hmzr = 0.0
     hmzi = 0.0
+    if flat:  # flat layout: every column first, then every sum
+        for j in range(Mc + 1):
+            if j > 0:
+                sr, si, se, vanished = _advance_seed(d[oA + _col(j, M)], rho, s, t, sr, si, se)
+                if vanished:
+                    zero_from = j
+                    break
+            _fill_column(
+                d, oA + _col(j, M), oB + _col(j, M), j, Mc, rhou, rho2, Q, j * W, WK + j, K,
+                sr, si, se,
+            )  # fmt: skip
+        for j in range(zero_from, Mc + 1):
+            for k in range(j, Mc + 1):
+                Q[j * W + k] = 0.0
+            Q[WK + j] = 0.0
+            Q[WK + K + j] = 0.0
+        done = Mc
     for m in range(N + 1):
         if m - lead >= zero_from:
             break
         # solid-harmonic columns m - 2 .. m + lead must be available
-        while done < m + lead:
+        while done < m + lead:  # ring layout: the columns as they become needed
             j = done + 1
             slot = j & 7
             qo = slot * W
             if j > 0 and j < zero_from:
-                kj = d[oA + _col(j, M)]
-                fr = kj * rho * s
-                fi = kj * rho * t
-                nr = fr * sr - fi * si
-                si = fr * si + fi * sr
-                sr = nr
-                mag = max(abs(sr), abs(si))
-                if mag == 0.0:
+                sr, si, se, vanished = _advance_seed(d[oA + _col(j, M)], rho, s, t, sr, si, se)
+                if vanished:
                     zero_from = j
-                else:
-                    while mag < BIGI:
-                        sr *= BIG
-                        si *= BIG
-                        mag *= BIG
-                        se -= 1
-                    while se < 0 and mag >= 1.0:
-                        sr *= BIGI
-                        si *= BIGI
-                        mag *= BIGI
-                        se += 1
             if j < zero_from:
-                oa = oA + _col(j, M)
-                ob = oB + _col(j, M)
-                e = se + _q_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo)
-                er = sr
-                ei = si
-                while e > 0:
-                    er *= BIG
-                    ei *= BIG
-                    e -= 1
-                while e < 0:
-                    er *= BIGI
-                    ei *= BIGI
-                    e += 1
-                Q[W8 + slot] = er
-                Q[W8 + 8 + slot] = ei
+                _fill_column(
+                    d, oA + _col(j, M), oB + _col(j, M), j, Mc, rhou, rho2, Q, qo, WK + slot, K,
+                    sr, si, se,
+                )  # fmt: skip
             else:
                 for k in range(j, Mc + 1):
                     Q[qo + k] = 0.0
-                Q[W8 + slot] = 0.0
-                Q[W8 + 8 + slot] = 0.0
+                Q[WK + slot] = 0.0
+                Q[WK + K + slot] = 0.0
             done = j
         n0 = 1 if (skip0 and m == 0) else m
         Lm = N + 1 - n0
         if Lm <= 0:
             continue
         cofs = _col(m, N) + n0 - m
-        q0 = (m & 7) * W
-        qp = ((m + 1) & 7) * W
-        qm = ((m - 1) & 7) * W if m >= 1 else qp
-        s0r = Q[W8 + (m & 7)]
-        s0i = Q[W8 + 8 + (m & 7)]
-        spr = Q[W8 + ((m + 1) & 7)]
-        spi = Q[W8 + 8 + ((m + 1) & 7)]
+        q0 = (m & mask) * W
+        qp = ((m + 1) & mask) * W
+        qm = ((m - 1) & mask) * W if m >= 1 else qp
+        s0r = Q[WK + (m & mask)]
+        s0i = Q[WK + K + (m & mask)]
+        spr = Q[WK + ((m + 1) & mask)]
+        spi = Q[WK + K + ((m + 1) & mask)]
         if want_u:
             uc, us = _potential_sums(d, oC + cofs, oS + cofs, Q, q0 + n0, Lm)
             pot += uc * s0r + us * s0i
         if want_a:
             k1 = n0 + 1
-            if N <= WEIGHTED:
+            if flat or N <= WEIGHTED:
                 zc, zs, pc, ps, mc, ms = _weighted_gradient_sums(
                     d, oC + cofs, oS + cofs, oW + cofs, oW + L + cofs, oW + 2 * L + cofs,
                     Q, q0 + k1, qp + k1, qm + k1, Lm,
@@ -583,21 +634,21 @@ def _point_body(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
                 if m == 1:
                     mc *= SQRT2
                     ms *= SQRT2
-                smr = Q[W8 + ((m - 1) & 7)]
-                smi = Q[W8 + 8 + ((m - 1) & 7)]
+                smr = Q[WK + ((m - 1) & mask)]
+                smi = Q[WK + K + ((m - 1) & mask)]
                 gmr += mc * smr + ms * smi
                 gmi += mc * smi - ms * smr
         if want_h:
             k2 = n0 + 2
-            qpp = ((m + 2) & 7) * W
-            qmm = ((m - 2) & 7) * W if m >= 2 else qp
+            qpp = ((m + 2) & mask) * W
+            qmm = ((m - 2) & mask) * W if m >= 2 else qp
             xc, xs, yc, ys, zc, zs, uc, us, vc, vs = _hessian_sums(
                 d, oC + cofs, oS + cofs, oF + n0,
                 oh + n0 + m + 1, oh + n0 - m + 1, oG + n0 + m + 1, oG + n0 - m + 1,
                 Q, q0 + k2, qp + k2, qpp + k2, qm + k2, qmm + k2, Lm,
             )  # fmt: skip
-            sppr = Q[W8 + ((m + 2) & 7)]
-            sppi = Q[W8 + 8 + ((m + 2) & 7)]
+            sppr = Q[WK + ((m + 2) & mask)]
+            sppi = Q[WK + K + ((m + 2) & mask)]
             hzz += zc * s0r + zs * s0i
             if m == 0:
                 # S[n, 0] = 0; the lowering operator acts on the conjugate
@@ -616,8 +667,8 @@ def _point_body(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
                 hppi += xc * sppi - xs * sppr
                 hpzr += yc * spr + ys * spi
                 hpzi += yc * spi - ys * spr
-                smr = Q[W8 + ((m - 1) & 7)]
-                smi = Q[W8 + 8 + ((m - 1) & 7)]
+                smr = Q[WK + ((m - 1) & mask)]
+                smi = Q[WK + K + ((m - 1) & mask)]
                 if m == 1:
                     uc *= SQRT2
                     us *= SQRT2
@@ -628,13 +679,13 @@ def _point_body(d, x, y, z, mode, Q):  # type: ignore[no-untyped-def]
                     if m == 2:
                         vc *= SQRT2
                         vs *= SQRT2
-                    smmr = Q[W8 + ((m - 2) & 7)]
-                    smmi = Q[W8 + 8 + ((m - 2) & 7)]
+                    smmr = Q[WK + ((m - 2) & mask)]
+                    smmi = Q[WK + K + ((m - 2) & mask)]
                     hmmr += vc * smmr + vs * smmi
                     hmmi += vc * smmi - vs * smmr
                 hmzr -= uc * smr + us * smi
                 hmzi -= uc * smi - us * smr
-    o = W8 + 16
+    o = WK + 2 * K
     if want_u:
         u = (mu / R) * pot
         if not math.isfinite(u):
@@ -684,15 +735,31 @@ _point = njit(cache=True)(_point_body)
 _point_inline = njit(cache=True, inline="always")(_point_body)
 
 
+#: Widest workspace laid out flat (see the module docstring): ``W = N + lead + 1`` up to
+#: this (degree 63 for the potential, 62 for the acceleration, 61 with the Hessian).
+FLAT_WIDTH = 64
+
+
+@njit(cache=True, inline="always")
+def layout(N: int, mode: int) -> tuple[bool, int]:
+    """Layout of the workspace of :func:`_point` for degree N and ``mode``: whether it is
+    flat (else a ring of eight columns), and its length (floats)."""
+    lead = 2 if (mode & 4) != 0 else (1 if (mode & 2) != 0 else 0)
+    W = N + lead + 1
+    flat = W <= FLAT_WIDTH
+    K = W if flat else 8
+    return flat, (W + 2) * K + 10
+
+
 @njit(cache=True, inline="always")
 def workspace_size(N: int, mode: int) -> int:
-    """Length of the workspace of :func:`_point` for degree N and ``mode``."""
-    lead = 2 if (mode & 4) != 0 else (1 if (mode & 2) != 0 else 0)
-    return 8 * (N + lead + 1) + 26
+    """Length of the workspace of :func:`_point` for degree N and ``mode`` (floats)."""
+    return layout(N, mode)[1]
 
 
-#: Largest workspace taken on the stack (floats; 4.3 kB): degree 61 with the Hessian.
-STACK_FLOATS = 8 * 64 + 26
+#: Largest workspace taken on the stack (floats; 34 kB): the widest flat one, or a ring up
+#: to degree 523 with the Hessian.
+STACK_FLOATS = (FLAT_WIDTH + 2) * FLAT_WIDTH + 10
 
 
 @intrinsic
@@ -713,20 +780,22 @@ def _stack_floats(typingctx):  # type: ignore[no-untyped-def]
 
 @njit(cache=True, inline="always")
 def _workspace(N, mode):  # type: ignore[no-untyped-def]
-    """A workspace for :func:`_point` (seed section zeroed) and the offset of its results.
+    """A workspace for :func:`_point`, the offset of its results and whether it is flat.
 
     On the stack of the kernel this is inlined into when it is small enough (see
     :data:`STACK_FLOATS`), on the heap otherwise. Either way every call has a workspace
     of its own (a stack frame is per call and per thread), so concurrent or nested calls
-    cannot share one.
+    cannot share one. The seeds and results of a ring are zeroed (a flat layout has every
+    seed written by :func:`_point`).
     """
-    size = workspace_size(N, mode)
+    flat, size = layout(N, mode)
     if size <= STACK_FLOATS:
         Q = carray(_stack_floats(), size)
     else:
         Q = np.empty(size)
-    Q[size - 26 :] = 0.0
-    return Q, size - 10
+    if not flat:
+        Q[size - 26 :] = 0.0
+    return Q, size - 10, flat
 
 
 # One explicit signature: positions typed read-only accept writable arrays as well, so a
@@ -760,9 +829,9 @@ def evaluate(d, r, out, hess, mode):  # type: ignore[no-untyped-def]
     want_a = (mode & 2) != 0
     want_h = (mode & 4) != 0
     stride = (1 if want_u else 0) + (3 if want_a else 0)
-    Q, o = _workspace(int(d[0]), mode)
+    Q, o, flat = _workspace(int(d[0]), mode)
     for ip in range(r.shape[0] // 3):
-        code = _point(d, r[3 * ip], r[3 * ip + 1], r[3 * ip + 2], mode, Q)
+        code = _point(d, r[3 * ip], r[3 * ip + 1], r[3 * ip + 2], mode, Q, flat)
         if code:
             return code + 4 * ip
         k = ip * stride
@@ -805,8 +874,11 @@ def acceleration_at(d, r, out, central):  # type: ignore[no-untyped-def]
     if r.shape[0] != 3:
         return NOT_ONE_POINT
     mode = 2 if central else 10
-    Q, o = _workspace(int(d[0]), mode)
-    code = _point_inline(d, r[0], r[1], r[2], mode, Q)
+    Q, o, flat = _workspace(int(d[0]), mode)
+    if flat:  # two copies, each with its layout fixed
+        code = _point_inline(d, r[0], r[1], r[2], mode, Q, True)
+    else:
+        code = _point_inline(d, r[0], r[1], r[2], mode, Q, False)
     if code == OK:
         out[0] = Q[o + 1]
         out[1] = Q[o + 2]
@@ -820,8 +892,11 @@ def acceleration_hessian_at(d, r, out, hess, central):  # type: ignore[no-untype
     if r.shape[0] != 3:
         return NOT_ONE_POINT
     mode = 6 if central else 14
-    Q, o = _workspace(int(d[0]), mode)
-    code = _point_inline(d, r[0], r[1], r[2], mode, Q)
+    Q, o, flat = _workspace(int(d[0]), mode)
+    if flat:  # two copies, each with its layout fixed
+        code = _point_inline(d, r[0], r[1], r[2], mode, Q, True)
+    else:
+        code = _point_inline(d, r[0], r[1], r[2], mode, Q, False)
     if code == OK:
         out[0] = Q[o + 1]
         out[1] = Q[o + 2]
@@ -844,8 +919,8 @@ def potential_at(d, r, out, central):  # type: ignore[no-untyped-def]
     if r.shape[0] != 3:
         return NOT_ONE_POINT
     mode = np.int64(1) if central else np.int64(9)
-    Q, o = _workspace(int(d[0]), mode)
-    code = _point(d, r[0], r[1], r[2], mode, Q)
+    Q, o, flat = _workspace(int(d[0]), mode)
+    code = _point(d, r[0], r[1], r[2], mode, Q, flat)
     if code == OK:
         out[0] = Q[o]
     return code

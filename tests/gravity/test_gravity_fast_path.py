@@ -160,16 +160,20 @@ def _padded(field, N):
 @pytest.mark.parametrize(
     "N",
     [
+        _kernels.FLAT_WIDTH - 3,  # largest degree whose workspaces are all flat
         (_kernels.STACK_FLOATS - 26) // 8 - 3,  # largest degree whose workspaces all fit
         _kernels.WEIGHTED,  # largest degree with stored gradient weights
     ],
 )
 def test_degrees_on_either_side_of_the_kernel_thresholds_agree(N):
-    # One more degree crosses to a heap workspace (with the Hessian) or to gradient sums
-    # that multiply their weights themselves; the numbers must not notice beyond round-off.
+    # One more degree crosses to a ring workspace, to a heap workspace (with the Hessian) or
+    # to gradient sums that multiply their weights themselves; the numbers must not notice
+    # beyond round-off.
     low = kaula_field(N, seed=9, amplitude=1e-4)
     high = _padded(low, N + 1)
-    if N != _kernels.WEIGHTED:
+    if N == _kernels.FLAT_WIDTH - 3:
+        assert _kernels.layout(N, 6)[0] and not _kernels.layout(N + 1, 6)[0]
+    elif N != _kernels.WEIGHTED:
         assert _kernels.workspace_size(N, 6) <= _kernels.STACK_FLOATS
         assert _kernels.workspace_size(N + 1, 6) > _kernels.STACK_FLOATS
     for r in _points(low.radius):
@@ -180,6 +184,43 @@ def test_degrees_on_either_side_of_the_kernel_thresholds_agree(N):
         scale = np.abs(ev.hessian).max()
         np.testing.assert_allclose(evh.hessian, ev.hessian, rtol=0, atol=1e-14 * scale)
         np.testing.assert_allclose(high.potential(r), low.potential(r), rtol=1e-15)
+
+
+def _in_layout(field, r, mode, flat):
+    """The ten results of the per-point kernel at ``r`` with the workspace laid out as told."""
+    lead = 2 if mode & 4 else (1 if mode & 2 else 0)
+    W = field.degree + lead + 1
+    Q = np.zeros((W + 2) * (W if flat else 8) + 10)
+    code = _kernels._point(field._data, r[0], r[1], r[2], mode, Q, flat)
+    return code, Q[-10:]
+
+
+@pytest.mark.parametrize("N", [0, 1, 2, 7, 20, _kernels.FLAT_WIDTH - 3])
+def test_flat_and_ring_layouts_give_the_same_numbers_bit_for_bit(N):
+    # Up to FLAT_WIDTH the workspace is flat (every column first, then every sum), above it
+    # a ring of eight columns made as needed. The arithmetic is the same, so the numbers
+    # must be too: in every mode, off and on the polar axis, very near it (seeds renormalised
+    # as extended-exponent numbers), far away and below the reference sphere.
+    field = kaula_field(N, seed=3, amplitude=1e-3)
+    R = field.radius
+    special = np.array(
+        [
+            [1e-300, 0.0, 1.2 * R],
+            [0.0, -5e-324, -1.1 * R],
+            [3e-160, 2e-160, 1.3 * R],
+            [4e10, -3e10, 1e10],
+            [0.3 * R, 0.2 * R, -0.1 * R],
+        ]
+    )
+    points = np.vstack([_points(R), special])
+    for mode in range(1, 16):
+        if not mode & 7:
+            continue
+        for r in points:
+            flat = _in_layout(field, r, mode, True)
+            ring = _in_layout(field, r, mode, False)
+            assert flat[0] == ring[0]
+            np.testing.assert_array_equal(flat[1], ring[1])
 
 
 def test_central_may_be_given_by_position_or_by_keyword():
