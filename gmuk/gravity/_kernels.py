@@ -440,54 +440,6 @@ def _hessian_sums(d, oc, os_, oF, oha, ohb, oga, ogb, Q, q0, qp, qpp, qm, qmm, L
     return xc, xs, yc, ys, zc, zs, uc, us, vc, vs
 
 
-@njit(cache=True, inline="always")
-def _advance_seed(kj, rho, s, t, sr, si, se):  # type: ignore[no-untyped-def]
-    """Seed σ_j = k_j ρ (s + i t) σ_{j-1} as a mantissa (sr, si) times BIG^se.
-
-    The mantissa is renormalised into [BIG⁻¹, 1) while the exponent is negative. Returns
-    ``(sr, si, se, vanished)``; ``vanished`` when σ_j is exactly zero (on the axis x = y = 0),
-    so is every later seed.
-    """
-    fr = kj * rho * s
-    fi = kj * rho * t
-    nr = fr * sr - fi * si
-    si = fr * si + fi * sr
-    sr = nr
-    mag = max(abs(sr), abs(si))
-    if mag == 0.0:
-        return sr, si, se, True
-    while mag < BIGI:
-        sr *= BIG
-        si *= BIG
-        mag *= BIG
-        se -= 1
-    while se < 0 and mag >= 1.0:
-        sr *= BIGI
-        si *= BIGI
-        mag *= BIGI
-        se += 1
-    return sr, si, se, False
-
-
-@njit(cache=True, inline="always")
-def _fill_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo, os_, K, sr, si, se):  # type: ignore[no-untyped-def]
-    """Column j (q_n, n = j..Mc, at ``Q[qo + n]``) and its seed σ_j as a plain float pair
-    at ``Q[os_]`` (real) and ``Q[os_ + K]`` (imaginary), the column's scalings folded in."""
-    e = se + _q_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo)
-    er = sr
-    ei = si
-    while e > 0:
-        er *= BIG
-        ei *= BIG
-        e -= 1
-    while e < 0:
-        er *= BIGI
-        ei *= BIGI
-        e += 1
-    Q[os_] = er
-    Q[os_ + K] = ei
-
-
 def _point_body(d, x, y, z, mode, Q, flat):  # type: ignore[no-untyped-def]
     """Values at one body-fixed point (x, y, z) (m), left in the workspace ``Q``.
 
@@ -553,40 +505,52 @@ def _point_body(d, x, y, z, mode, Q, flat):  # type: ignore[no-untyped-def]
     hpzi = 0.0
     hmzr = 0.0
     hmzi = 0.0
-    if flat:  # flat layout: every column first, then every sum
-        for j in range(Mc + 1):
-            if j > 0:
-                sr, si, se, vanished = _advance_seed(d[oA + _col(j, M)], rho, s, t, sr, si, se)
-                if vanished:
-                    zero_from = j
-                    break
-            _fill_column(
-                d, oA + _col(j, M), oB + _col(j, M), j, Mc, rhou, rho2, Q, j * W, WK + j, K,
-                sr, si, se,
-            )  # fmt: skip
-        for j in range(zero_from, Mc + 1):
-            for k in range(j, Mc + 1):
-                Q[j * W + k] = 0.0
-            Q[WK + j] = 0.0
-            Q[WK + K + j] = 0.0
-        done = Mc
     for m in range(N + 1):
         if m - lead >= zero_from:
             break
-        # solid-harmonic columns m - 2 .. m + lead must be available
-        while done < m + lead:  # ring layout: the columns as they become needed
+        # flat layout: every column at m = 0, then every sum; ring: solid-harmonic columns
+        # m - 2 .. m + lead must be available
+        while done < (Mc if flat else m + lead):
             j = done + 1
-            slot = j & 7
+            slot = j & mask
             qo = slot * W
             if j > 0 and j < zero_from:
-                sr, si, se, vanished = _advance_seed(d[oA + _col(j, M)], rho, s, t, sr, si, se)
-                if vanished:
+                kj = d[oA + _col(j, M)]
+                fr = kj * rho * s
+                fi = kj * rho * t
+                nr = fr * sr - fi * si
+                si = fr * si + fi * sr
+                sr = nr
+                mag = max(abs(sr), abs(si))
+                if mag == 0.0:
                     zero_from = j
+                else:
+                    while mag < BIGI:
+                        sr *= BIG
+                        si *= BIG
+                        mag *= BIG
+                        se -= 1
+                    while se < 0 and mag >= 1.0:
+                        sr *= BIGI
+                        si *= BIGI
+                        mag *= BIGI
+                        se += 1
             if j < zero_from:
-                _fill_column(
-                    d, oA + _col(j, M), oB + _col(j, M), j, Mc, rhou, rho2, Q, qo, WK + slot, K,
-                    sr, si, se,
-                )  # fmt: skip
+                oa = oA + _col(j, M)
+                ob = oB + _col(j, M)
+                e = se + _q_column(d, oa, ob, j, Mc, rhou, rho2, Q, qo)
+                er = sr
+                ei = si
+                while e > 0:
+                    er *= BIG
+                    ei *= BIG
+                    e -= 1
+                while e < 0:
+                    er *= BIGI
+                    ei *= BIGI
+                    e += 1
+                Q[WK + slot] = er
+                Q[WK + K + slot] = ei
             else:
                 for k in range(j, Mc + 1):
                     Q[qo + k] = 0.0
@@ -723,15 +687,17 @@ def _point_body(d, x, y, z, mode, Q, flat):  # type: ignore[no-untyped-def]
     return OK
 
 
-#: :func:`_point_body` compiled on its own (the batch kernel and the potential entries call
-#: it with a mode known only at run time) ...
+#: :func:`_point_body` compiled on its own: the batch kernel and the potential entry call it
+#: with the mode and the layout known only at run time, the acceleration entries for a
+#: ring (degree 62 and up, where a call costs nothing beside the series) ...
 _point = njit(cache=True)(_point_body)
-#: ... and inlined into the acceleration entries, each of which fixes every mode bit but
-#: the central-term one: LLVM then drops the potential and the unused derivative code
-#: (the entry's machine code shrinks by about 40 %). Called from Python that made a
-#: degree-10 call faster, though a compiled loop over the two versions shows far less: a
-#: call from Python starts with cold caches and branch history, which favour smaller code
-#: (figures in benchmarks/README.md, Gravity).
+#: ... and inlined into the acceleration entries for the flat layout, each of which fixes
+#: every mode bit but the central-term one: LLVM then drops the ring, the potential and the
+#: unused derivative code (the entry's machine code shrinks by about 40 %). Called from
+#: Python that made a degree-10 call faster, though a compiled loop over the two versions
+#: shows far less: a call from Python starts with cold caches and branch history, which
+#: favour smaller code (figures in benchmarks/README.md, Gravity). Inlining the ring too
+#: would add ~4 s per entry to the first import's compilation for nothing measurable.
 _point_inline = njit(cache=True, inline="always")(_point_body)
 
 
@@ -875,10 +841,10 @@ def acceleration_at(d, r, out, central):  # type: ignore[no-untyped-def]
         return NOT_ONE_POINT
     mode = 2 if central else 10
     Q, o, flat = _workspace(int(d[0]), mode)
-    if flat:  # two copies, each with its layout fixed
+    if flat:  # inlined, request and layout fixed
         code = _point_inline(d, r[0], r[1], r[2], mode, Q, True)
-    else:
-        code = _point_inline(d, r[0], r[1], r[2], mode, Q, False)
+    else:  # degree 62 and up: a call costs nothing beside the series
+        code = _point(d, r[0], r[1], r[2], mode, Q, False)
     if code == OK:
         out[0] = Q[o + 1]
         out[1] = Q[o + 2]
@@ -893,10 +859,10 @@ def acceleration_hessian_at(d, r, out, hess, central):  # type: ignore[no-untype
         return NOT_ONE_POINT
     mode = 6 if central else 14
     Q, o, flat = _workspace(int(d[0]), mode)
-    if flat:  # two copies, each with its layout fixed
+    if flat:  # inlined, request and layout fixed
         code = _point_inline(d, r[0], r[1], r[2], mode, Q, True)
-    else:
-        code = _point_inline(d, r[0], r[1], r[2], mode, Q, False)
+    else:  # degree 62 and up: a call costs nothing beside the series
+        code = _point(d, r[0], r[1], r[2], mode, Q, False)
     if code == OK:
         out[0] = Q[o + 1]
         out[1] = Q[o + 2]
