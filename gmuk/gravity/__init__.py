@@ -65,7 +65,9 @@ the Hessian follows from ``D₊²``, ``D₋²``, ``D±∂z``, ``∂z²`` with ``
 (Laplace). There is no division by cos φ anywhere: the poles are ordinary points, and the
 Hessian is exactly symmetric and, to round-off, traceless. The gradient needs solid
 harmonics to degree N+1, the Hessian to N+2; one pass over the coefficients serves
-potential, gradient and Hessian together. Cost O(N²) per point, memory O(N) per point.
+potential, gradient and Hessian together. Cost O(N²) per point; memory per point O(N²)
+up to degree 61 (every solid-harmonic column at once, at most 34 kB, on the stack) and
+O(N) above (a ring of eight columns).
 
 Any degree: the seeds σ_m underflow near the poles and for large m, and the column values
 q_nm can overflow there; both are carried as extended-exponent numbers (mantissa ·
@@ -74,11 +76,12 @@ formed, so terms that matter are never lost to underflow. No factorials are form
 anywhere; every coefficient is a square root of a ratio of small integers.
 
 The kernels are compiled with numba (``gmuk.gravity._kernels``; explicit signatures,
-cached on disk): the first import compiles them, 25 s on the project's shared 2-core
-machine (``python -c "import gmuk.gravity.field"`` with an empty ``NUMBA_CACHE_DIR``; 20 s
-before the acceleration entries got their own inlined copies), and later imports load them
-from the cache (2 s for the whole import). A field precomputes its recursion coefficients
-and square-root tables once, at construction or ``truncate``.
+cached on disk): the first import compiles them, 34-35 s on the project's shared 2-core
+machine (``python -c "import gmuk.gravity.field"`` with an empty ``NUMBA_CACHE_DIR``;
+27-28 s for the code before the flat workspace of low degrees, timed alternately with it),
+and later imports load them from the cache (2 s for the whole import). A field
+precomputes its recursion coefficients and square-root tables once, at construction or
+``truncate``.
 
 Speed: a single position given as a float64 array of shape (3,) (any strides) takes a
 fast path: one compiled call without numba's type dispatch, which reads the position where
@@ -87,7 +90,7 @@ batches) goes through the batch kernel. Both run the same per-point code (compil
 each entry, the single-point ones with their request fixed), and the tests check that they
 agree bit for bit, across requests too (``acceleration`` and ``acceleration_hessian``).
 Rigid-body gravity wants ∇U and ∇∇U at every step: ``acceleration_hessian`` gives both
-from one pass, for 1.4–2.1× the cost of the acceleration alone. Measured medians on the
+from one pass, for 1.5–1.9× the cost of the acceleration alone. Measured medians on the
 shared 2-core machine, beside pyshtools 4.14 in the same run, are in
 ``benchmarks/README.md`` (``python benchmarks/bench_gravity.py``).
 

@@ -49,8 +49,9 @@ and ten results (U, ∇U, and the upper triangle of the Hessian, row by row). Tw
 for bit, as the tests check):
 
 * flat, for ``W ≤`` :data:`FLAT_WIDTH` (degree ≤ 61 whatever the request): ``K = W``, column
-  j in slot j; every column is made first, then every sum. One loop after the other
-  was 5-20 % faster than interleaving them (degrees 10-60, compiled loops;
+  j in slot j; every column is made first (at m = 0), then every sum. That was ≈ 10 %
+  faster than making the columns as the sums reach them at degrees 10-20, and a few per
+  cent or within the noise at 30-60 (compiled loops, throwaway A/B scripts; figures in
   ``benchmarks/README.md``, Gravity);
 * a ring above that: ``K = 8``, column j in slot ``j mod 8``, each column made when the
   sums first need it, so that the workspace stays small at high degree.
