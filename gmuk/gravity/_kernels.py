@@ -697,8 +697,9 @@ _point = njit(cache=True)(_point_body)
 #: unused derivative code (the entry's machine code shrinks by about 40 %). Called from
 #: Python that made a degree-10 call faster, though a compiled loop over the two versions
 #: shows far less: a call from Python starts with cold caches and branch history, which
-#: favour smaller code (figures in benchmarks/README.md, Gravity). Inlining the ring too
-#: would add ~4 s per entry to the first import's compilation for nothing measurable.
+#: favour smaller code (figures in benchmarks/README.md, Gravity). Inlining the ring as
+#: well (as 82d88a0 did) made the first import's compilation ≈ 10 s longer, for no speed
+#: that could be measured.
 _point_inline = njit(cache=True, inline="always")(_point_body)
 
 
