@@ -10,6 +10,9 @@ Public API
   the three in one pass; ``acceleration_hessian`` is the lean call for ∇U and ∇∇U
   together). ``central=False`` gives the perturbation only (every term but
   C̄₀₀), which is what rigid-body force models add to their point-mass part.
+* :func:`load` ``(name, degree=None)``: a field shipped with gmuk by name,
+  ``"GRGM660PRIM"`` (Moon, GRAIL, to degree 150) or ``"EGM2008"`` (Earth, to degree 70);
+  :func:`available` lists them (provenance and licence in ``gmuk/gravity/data/README.md``).
 * :func:`load_gfc` (ICGEM ``.gfc``) and :func:`load_shadr` (PDS SHADR ``.tab``, GRAIL's
   archive format): readers returning a field in SI units; malformed files raise
   :class:`gmuk.errors.FileFormatError` naming the file, the line and what was expected.
@@ -133,6 +136,7 @@ from gmuk.gravity.builtin import (
     moon_low_degree,
     moon_point_mass,
 )
+from gmuk.gravity.catalog import FieldInfo, available, field_path, load
 from gmuk.gravity.field import FieldValues, SphericalHarmonicField
 from gmuk.gravity.io import load_gfc, load_shadr
 from gmuk.gravity.legendre import legendre_4pi, normalization_4pi
@@ -148,10 +152,14 @@ __all__ = [
     "EARTH_RADIUS",
     "MOON_MU",
     "MOON_RADIUS",
+    "FieldInfo",
     "FieldValues",
     "SphericalHarmonicField",
+    "available",
     "earth_point_mass",
+    "field_path",
     "legendre_4pi",
+    "load",
     "load_gfc",
     "load_shadr",
     "moon_low_degree",
