@@ -11,6 +11,7 @@ A body holds only constants (name, mass properties); its state lives in a
 from __future__ import annotations
 
 import abc
+import enum
 from typing import Any, ClassVar
 
 import numpy as np
@@ -19,7 +20,7 @@ from gmuk._validation import FloatArray
 from gmuk.dynamics import check_inertia
 from gmuk.errors import DefinitionError, InertiaError
 
-__all__ = ["Body", "PointMass", "RigidBody", "SlackCoordinate"]
+__all__ = ["Body", "BodyKind", "PointMass", "RigidBody", "SlackCoordinate"]
 
 
 def _check_name(name: Any) -> str:
@@ -38,27 +39,64 @@ def _check_mass(mass: Any, name: str) -> float:
     return m
 
 
-class Body(abc.ABC):
-    """A part with mass and ``dof`` degrees of freedom.
+class BodyKind(str, enum.Enum):
+    """What a body's coordinates are, which decides how the integrator moves it.
 
-    Subclasses define ``dof`` and :meth:`mass_matrix`. Bodies are immutable and compare
-    by identity; the System refers to them by their unique ``name``.
+    The values are the short tags written in saved trajectories; a kind compares equal to
+    its tag (``BodyKind.RIGID == "rigid"``).
+    """
+
+    #: 6 dof on SE(3): pose g_NB (4, 4) and body twist V_B = [ω; v] (6,).
+    RIGID = "rigid"
+    #: 3 dof in R³: position r_N and velocity v_N (3,), inertial frame.
+    POINT = "point"
+    #: 1 dof in R: a scalar coordinate s and its rate (slack and excess variables).
+    SLACK = "slack"
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __hash__(self) -> int:  # hash as the tag, so that a dict keyed by tags finds a kind
+        return str.__hash__(self)
+
+
+class Body(abc.ABC):
+    """A part with a mass and ``dof`` degrees of freedom.
+
+    Every body has a unique :attr:`name`, a :attr:`mass` (kg, or the weight of a slack
+    coordinate), a :attr:`kind` and a constant :meth:`mass_matrix`. Subclasses set the class
+    attributes ``dof`` and ``kind`` and implement :meth:`mass_matrix`. Bodies are immutable
+    and compare by identity; the System refers to them by their unique ``name``.
+
+    Parameters
+    ----------
+    name : str
+        Unique name within a System.
+    mass : float
+        Mass (kg), finite and > 0.
     """
 
     dof: ClassVar[int]
-    #: Short tag used in saved trajectories: "rigid", "point" or "slack".
-    kind: ClassVar[str]
+    kind: ClassVar[BodyKind]
 
-    __slots__ = ("_name",)
+    __slots__ = ("_mass", "_name")
     _name: str
+    _mass: float
 
-    def __init__(self, name: str) -> None:
-        object.__setattr__(self, "_name", _check_name(name))
+    def __init__(self, name: str, mass: float) -> None:
+        name = _check_name(name)
+        object.__setattr__(self, "_name", name)
+        object.__setattr__(self, "_mass", _check_mass(mass, f"{type(self).__name__} {name!r}"))
 
     @property
     def name(self) -> str:
         """Unique name of the body within a System."""
         return self._name
+
+    @property
+    def mass(self) -> float:
+        """Mass m (kg); for a slack coordinate, its weight in the Gauss function."""
+        return self._mass
 
     @abc.abstractmethod
     def mass_matrix(self) -> FloatArray:
@@ -90,23 +128,16 @@ class RigidBody(Body):
     """
 
     dof = 6
-    kind = "rigid"
-    __slots__ = ("_J", "_mass")
-    _mass: float
+    kind = BodyKind.RIGID
+    __slots__ = ("_J",)
     _J: FloatArray
 
     def __init__(self, name: str, mass: float, inertia: Any) -> None:
-        super().__init__(name)
-        m, J = check_inertia(mass, inertia, name=f"RigidBody {name!r}")
+        m, J = check_inertia(mass, inertia, name=f"RigidBody {_check_name(name)!r}")
+        super().__init__(name, m)
         J = J.copy()
         J.setflags(write=False)
-        object.__setattr__(self, "_mass", m)
         object.__setattr__(self, "_J", J)
-
-    @property
-    def mass(self) -> float:
-        """Mass (kg)."""
-        return self._mass
 
     @property
     def inertia(self) -> FloatArray:
@@ -132,18 +163,8 @@ class PointMass(Body):
     """
 
     dof = 3
-    kind = "point"
-    __slots__ = ("_mass",)
-    _mass: float
-
-    def __init__(self, name: str, mass: float) -> None:
-        super().__init__(name)
-        object.__setattr__(self, "_mass", _check_mass(mass, f"PointMass {name!r}"))
-
-    @property
-    def mass(self) -> float:
-        """Mass (kg)."""
-        return self._mass
+    kind = BodyKind.POINT
+    __slots__ = ()
 
     def mass_matrix(self) -> FloatArray:
         """``m I₃``, shape (3, 3)."""
@@ -166,18 +187,11 @@ class SlackCoordinate(Body):
     """
 
     dof = 1
-    kind = "slack"
-    __slots__ = ("_mass",)
-    _mass: float
+    kind = BodyKind.SLACK
+    __slots__ = ()
 
     def __init__(self, name: str, mass: float = 1.0) -> None:
-        super().__init__(name)
-        object.__setattr__(self, "_mass", _check_mass(mass, f"SlackCoordinate {name!r}"))
-
-    @property
-    def mass(self) -> float:
-        """Weight of the coordinate."""
-        return self._mass
+        super().__init__(name, mass)
 
     def mass_matrix(self) -> FloatArray:
         """``[[mass]]``, shape (1, 1)."""

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Union
 import numpy as np
 
 from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError
 
 if TYPE_CHECKING:
@@ -26,7 +27,7 @@ BodyRef = Union["Body", str]
 
 @dataclass(frozen=True)
 class _Slot:
-    kind: str  # "rigid", "point", "slack"
+    kind: BodyKind
     index: int  # rigid: index into g/V; euclidean: offset into x/xdot
     dof: int
     offset: int  # offset in the generalized velocity vector ν
@@ -40,8 +41,8 @@ class Layout:
     ----------
     names : tuple of str
         Body names in System order (the order of ν, A's columns and accelerations).
-    kinds : tuple of str
-        "rigid", "point" or "slack" for each body.
+    kinds : tuple of BodyKind
+        The kind of each body (given as BodyKind or its tag "rigid", "point", "slack").
     n_dof : int
         Σ dof: length of the generalized velocity ν.
     n_rigid, n_euclid, n_control : int
@@ -50,7 +51,7 @@ class Layout:
     """
 
     names: tuple[str, ...]
-    kinds: tuple[str, ...]
+    kinds: tuple[BodyKind, ...]
     dofs: tuple[int, ...]
     n_control: int = 0
     _slots: dict[str, _Slot] = field(init=False, repr=False, compare=False)
@@ -61,12 +62,19 @@ class Layout:
     euclid_offsets: FloatArray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        try:
+            kinds = tuple(BodyKind(k) for k in self.kinds)
+        except ValueError:
+            raise DefinitionError(
+                f"body kinds must be among {[k.value for k in BodyKind]}; got {list(self.kinds)}"
+            ) from None
+        object.__setattr__(self, "kinds", kinds)
         slots: dict[str, _Slot] = {}
         offset = n_rigid = n_euclid = 0
         rigid_off: list[int] = []
         euclid_off: list[int] = []
-        for name, kind, dof in zip(self.names, self.kinds, self.dofs, strict=True):
-            if kind == "rigid":
+        for name, kind, dof in zip(self.names, kinds, self.dofs, strict=True):
+            if kind is BodyKind.RIGID:
                 slots[name] = _Slot(kind, n_rigid, dof, offset)
                 rigid_off.append(offset)
                 n_rigid += 1

@@ -14,7 +14,6 @@ McCann (2020), Eqs. (2)–(3) (point masses), (63)–(64) (rigid bodies on R⁶)
 from __future__ import annotations
 
 import itertools
-import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -23,40 +22,24 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from gmuk import _uk_kernels, uk
-from gmuk._numba import entry
-from gmuk._validation import FloatArray, all_finite, as_array, check_se3
-from gmuk.bodies import Body, RigidBody
+from gmuk import _uk_kernels, solvers, uk
+from gmuk._validation import FloatArray, as_array, check_se3
+from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
-from gmuk.constraints.relative import RelativeConstraint
-from gmuk.constraints.tangent_bundle import TangentBundleConstraint
-from gmuk.constraints.tracking import ConfigurationTracking
 from gmuk.control.base import Controller
-from gmuk.errors import (
-    ConstraintError,
-    DefinitionError,
-    InconsistentConstraintsError,
-    InconsistentConstraintsWarning,
-)
+from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
-from gmuk.lie import se3
+from gmuk.integrate import simulate as _simulate
+from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS, UKSolver
 from gmuk.state import Layout, State
 
 if TYPE_CHECKING:
     from gmuk.trajectory import Trajectory
 
-__all__ = ["Accelerations", "System"]
+__all__ = ["QR_COND_LIMIT", "QR_MAX_ROWS", "SPARSE_THRESHOLD", "Accelerations", "System"]
 
-#: Above this many degrees of freedom (or constraint rows), "auto" selects the sparse path.
+#: Above this many degrees of freedom, ``sparse="auto"`` selects the sparse solve.
 SPARSE_THRESHOLD = 300
-#: Dense path: up to this many rows, full-row-rank A is solved by Householder QR (compiled,
-#: no LAPACK set-up) when its condition number is certified ≤ QR_COND_LIMIT; else by SVD.
-QR_MAX_ROWS = 48
-QR_COND_LIMIT = 1e8
-_EPS = float(np.finfo(float).eps)
-_F64 = np.dtype(np.float64)
-_empty = np.empty
-_uk_rigid_c = entry(_uk_kernels.uk_rigid_c)
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,31 +112,50 @@ class System:
     constraints : sequence of Constraint
     forces : sequence of ForceModel
     controllers : sequence of Controller
+    solver : str or UKSolver subclass, optional
+        The Udwadia–Kalaba solve strategy (:mod:`gmuk.solvers`): "fused", "dense",
+        "sparse", "eq80", or any registered name or subclass. Default: chosen from
+        ``sparse`` and ``tangent_bundle_method`` — "eq80" when asked for, "sparse" when
+        ``sparse`` is True (or "auto" above ``SPARSE_THRESHOLD`` dof), else "fused" when the
+        System allows it (rigid bodies only, every load modeled), else "dense".
     sparse : {"auto", True, False}
-        Solve path: "auto" uses sparse linear algebra above ``SPARSE_THRESHOLD`` dof.
+        Sparse or dense rows and mass blocks when ``solver`` is not given.
     sparse_solver : {"lu", "cg"}
         Sparse solve of A M⁻¹ Aᵀ λ = r: direct LU (exact; best for chain- or mesh-like
         coupling) or conjugate gradients (best for large, randomly coupled systems); see
         :func:`gmuk.uk.solve_sparse`.
     tangent_bundle_method : {"reachable", "eq80"}
         How a :class:`~gmuk.constraints.TangentBundleConstraint` is solved. "reachable"
-        (default) restricts ``A g̈ B = C`` to reachable accelerations ``g(V^² + V̇^)`` and
-        solves the resulting R⁶ rows by Gauss's principle (:func:`gmuk.uk.reachable_rows`);
-        "eq80" applies McCann (2020) Eq. 80 as printed and projects each body's block of
-        g̈_c onto g·se(3) (``Accelerations.unreachable`` says how much it discarded). They
-        agree for full tracking (A = B = I₄).
+        (default): its rows restrict ``A g̈ B = C`` to reachable accelerations
+        ``g(V^² + V̇^)`` (:func:`gmuk.uk.reachable_rows`) and stack with any other
+        constraint's rows. "eq80": McCann (2020) Eq. 80 as printed, each body's block of
+        g̈_c projected onto g·se(3) (``Accelerations.unreachable`` says how much it
+        discarded); the System then takes that one constraint only. They agree for full
+        tracking (A = B = I₄).
     strict : bool
         Raise :class:`gmuk.errors.InconsistentConstraintsError` on inconsistent constraints
         instead of warning.
     consistency_tol : float
         Constraints count as inconsistent when ‖A ν̇ − b‖ > tol · max(1, ‖b‖, ‖A ν̇_a‖).
     rcond : float, optional
-        Relative singular-value cut-off for the rank of A M^{-1/2} (dense path).
+        Relative singular-value cut-off for the rank of A M^{-1/2} (dense solves).
+
+    Attributes
+    ----------
+    solver : UKSolver
+        The strategy chosen for this System.
 
     Raises
     ------
     DefinitionError
-        Listing every problem found (duplicate names, unknown bodies, wrong kinds …).
+        Listing every problem found (duplicate names, unknown bodies, a part given a body
+        of a kind it does not act on, a solver that cannot take these parts …).
+
+    Notes
+    -----
+    Each part declares what it needs, and the System checks it here, once: constraints their
+    ``body_kinds``, force models their ``acts_on``, solve strategies their ``problems``. A
+    new kind of part needs no change to the System.
     """
 
     def __init__(
@@ -163,6 +165,7 @@ class System:
         forces: Sequence[ForceModel] = (),
         controllers: Sequence[Controller] = (),
         *,
+        solver: str | type[UKSolver] | None = None,
         sparse: bool | str = "auto",
         sparse_solver: str = "lu",
         tangent_bundle_method: str = "reachable",
@@ -206,38 +209,44 @@ class System:
             n_ctrl,
         )
         self._by_name = {b.name: b for b in self.bodies}
-        # Rows are unknown until evaluated; the number of dof decides "auto".
-        self.sparse = (self.layout.n_dof > SPARSE_THRESHOLD) if sparse == "auto" else bool(sparse)
-        self._build_mass()
-        self._build_index()
-        self.tangent_bundle = any(isinstance(c, TangentBundleConstraint) for c in self.constraints)
         # Whether anything acts on the plant that the UK solve does not see.
         self._plant_only_loads = bool(self.controllers) or any(not f.modeled for f in self.forces)
-        # Small dense all-rigid R⁶ systems: free accelerations, QR solve and packing in one
-        # compiled call (uk_rigid); anything else, or a rank it cannot certify, takes the
-        # general path.
         self._zero_loads = np.zeros(self.layout.n_dof)
         self._zero_loads.setflags(write=False)
         self._zero_z = self._zero_loads[:0]
-        # QR-eligible rows have s ≤ n, so the SVD's default rcond would be n·ε: certify
-        # κ ≤ min(QR_COND_LIMIT, 0.1/rcond) so that the QR never keeps a rank the SVD drops.
-        rc = self.rcond if self.rcond is not None else max(self.layout.n_dof, 1) * _EPS
-        self._qr_cond_limit = min(QR_COND_LIMIT, 0.1 / rc)
-        self._single_dense = self._single_full_width and not (self.sparse or self.tangent_bundle)
-        self._fused = not (
-            self.sparse or self.tangent_bundle or self._plant_only_loads or self.layout.n_euclid
-        ) and bool(self.constraints)
-        if self._fused:
-            self._V_shape = (self.layout.n_rigid, 6)
-            self._uk_params = _uk_kernels.rigid_params(
-                self._J,
-                self._Jinv,
-                self._m_rigid,
-                self._Minv_sqrt,
-                self._M_dense,
-                self._qr_cond_limit,
-                self.consistency_tol,
-            )
+        solver_cls = self._choose_solver(solver, sparse)
+        self.sparse = solver_cls.sparse
+        self._build_mass()
+        self._build_index()
+        self.solver: UKSolver = solver_cls(self)
+
+    def _choose_solver(self, solver: object, sparse: bool | str) -> type[UKSolver]:
+        """The solve strategy: given, or chosen from the options and the parts."""
+        if solver is not None:
+            if sparse != "auto" or self.tangent_bundle_method != "reachable":
+                raise DefinitionError(
+                    "give either solver= or the sparse= / tangent_bundle_method= options, "
+                    f"not both; got solver={solver!r}, sparse={sparse!r}, "
+                    f"tangent_bundle_method={self.tangent_bundle_method!r}"
+                )
+            cls = solvers.resolve(solver)
+        elif self.tangent_bundle_method == "eq80":
+            cls = solvers.TangentBundleEq80Solver
+        elif sparse is True or (sparse == "auto" and self.layout.n_dof > SPARSE_THRESHOLD):
+            cls = solvers.SparseSolver
+        elif not solvers.FusedRigidSolver.problems(self):
+            cls = solvers.FusedRigidSolver
+        else:
+            cls = solvers.DenseSolver
+        problems = cls.problems(self)
+        if problems:
+            raise DefinitionError(problems)
+        return cls
+
+    @property
+    def tangent_bundle(self) -> bool:
+        """Whether the System is solved by McCann (2020) Eq. 80 on T²SE(3)."""
+        return isinstance(self.solver, solvers.TangentBundleEq80Solver)
 
     # ------------------------------------------------------------------ validation
     def _validate(self) -> list[str]:
@@ -256,9 +265,8 @@ class System:
             problems.append("a System needs at least one body")
         kinds = {b.name: b.kind for b in self.bodies if isinstance(b, Body)}
 
-        def check_refs(
-            part: Any, label: str, refs: Iterable[Body | str], rigid_only: bool = False
-        ) -> None:
+        def check_refs(label: str, refs: Iterable[Body | str], allowed: Iterable[str]) -> None:
+            allowed = frozenset(allowed)
             for ref in refs:
                 name = ref if isinstance(ref, str) else getattr(ref, "name", None)
                 if name not in kinds:
@@ -267,39 +275,31 @@ class System:
                     )
                 elif not isinstance(ref, str) and self.bodies[names[name]] is not ref:
                     problems.append(f"{label} refers to a different body object named {name!r}")
-                elif rigid_only and kinds[name] != "rigid":
-                    problems.append(f"{label} needs rigid bodies; {name!r} is a {kinds[name]} body")
+                elif kinds[name] not in allowed:
+                    problems.append(
+                        f"{label} acts on {' and '.join(sorted(map(str, allowed)))} bodies; "
+                        f"{name!r} is a {kinds[name]} body"
+                    )
 
-        n_tangent = 0
         for i, c in enumerate(self.constraints):
             if not isinstance(c, Constraint):
                 problems.append(
                     f"constraints[{i}] must be a gmuk.Constraint; got {type(c).__name__}"
                 )
-                continue
-            rigid = isinstance(
-                c, (RelativeConstraint, ConfigurationTracking, TangentBundleConstraint)
-            )
-            check_refs(c, f"constraint {c.name!r}", c.bodies, rigid_only=rigid)
-            n_tangent += isinstance(c, TangentBundleConstraint)
-        if n_tangent and (n_tangent > 1 or len(self.constraints) > 1):
-            problems.append(
-                "a T²SE(3) System takes exactly one TangentBundleConstraint and no "
-                f"other constraint (Eq. 79 does not stack); got {n_tangent} of "
-                f"{len(self.constraints)} constraints"
-            )
+            else:
+                check_refs(f"constraint {c.name!r}", c.bodies, c.body_kinds)
         for i, f in enumerate(self.forces):
             if not isinstance(f, ForceModel):
                 problems.append(f"forces[{i}] must be a gmuk.ForceModel; got {type(f).__name__}")
             elif f.bodies is not None:
-                check_refs(f, f"force {f.name!r}", f.bodies)
+                check_refs(f"force {f.name!r}", f.bodies, f.acts_on)
         for i, ctl in enumerate(self.controllers):
             if not isinstance(ctl, Controller):
                 problems.append(
                     f"controllers[{i}] must be a gmuk.Controller; got {type(ctl).__name__}"
                 )
             else:
-                check_refs(ctl, f"controller {ctl.name!r}", ctl.bodies)
+                check_refs(f"controller {ctl.name!r}", ctl.bodies, BodyKind)
         return problems
 
     # ------------------------------------------------------------------ set-up
@@ -310,11 +310,9 @@ class System:
         self._J = np.array([b.inertia for b in rigid]).reshape(-1, 3, 3)
         self._Jinv = np.linalg.inv(self._J) if rigid else self._J.copy()
         self._m_rigid = np.array([b.mass for b in rigid])
-        euclid = [b for b in self.bodies if b.kind != "rigid"]
+        euclid = [b for b in self.bodies if b.kind is not BodyKind.RIGID]
         self._m_euclid = (
-            np.concatenate([np.full(b.dof, b.mass) for b in euclid])  # type: ignore[attr-defined]
-            if euclid
-            else np.zeros(0)
+            np.concatenate([np.full(b.dof, b.mass) for b in euclid]) if euclid else np.zeros(0)
         )
         inv = [np.linalg.inv(B) for B in blocks]
         inv_sqrt = [uk.matrix_power_spd(B, -0.5) for B in blocks]
@@ -325,11 +323,6 @@ class System:
             self._M_dense = scipy.linalg.block_diag(*blocks)
             self._Minv_dense = scipy.linalg.block_diag(*inv)
             self._Minv_sqrt = scipy.linalg.block_diag(*inv_sqrt)
-        if rigid:  # 𝕀̃^{-1/4} blocks for the T²SE(3) solve: blkdiag(J^{-1/4}, m^{-1/4})
-            self._I_tilde_m14_blocks = [
-                scipy.linalg.block_diag(uk.matrix_power_spd(b.inertia, -0.25), [[b.mass**-0.25]])
-                for b in rigid
-            ]
 
     @property
     def mass_matrix(self) -> FloatArray:
@@ -353,10 +346,11 @@ class System:
         self._single_full_width = len(self._constraint_cols) == 1 and np.array_equal(
             self._constraint_cols[0], np.arange(lay.n_dof)
         )
+        self._single_dense = self._single_full_width and not self.sparse
         self._force_bodies: list[list[Body]] = []
         for f in self.forces:
             if f.bodies is None:
-                bs = [b for b in self.bodies if b.kind != "slack"]
+                bs = [b for b in self.bodies if b.kind in f.acts_on]
             else:
                 bs = [self._resolve(r) for r in f.bodies]
             self._force_bodies.append(bs)
@@ -409,7 +403,11 @@ class System:
             "s": dict(s or {}),
             "s_dot": dict(s_dot or {}),
         }
-        need = {"rigid": ("g", "V"), "point": ("r", "v"), "slack": ("s", "s_dot")}
+        need = {
+            BodyKind.RIGID: ("g", "V"),
+            BodyKind.POINT: ("r", "v"),
+            BodyKind.SLACK: ("s", "s_dot"),
+        }
         for key, mapping in given.items():
             for name in mapping:
                 if name not in self._by_name:
@@ -434,7 +432,7 @@ class System:
         xd = np.zeros(lay.n_euclid)
         for b in self.bodies:
             sl = lay.slot(b)
-            if b.kind == "rigid":
+            if b.kind is BodyKind.RIGID:
                 G[sl.index] = check_se3(given["g"][b.name], f"g[{b.name!r}]")
                 Vs[sl.index] = as_array(given["V"][b.name], (6,), f"V[{b.name!r}]", batch=False)
             else:
@@ -618,165 +616,16 @@ class System:
         """
         if state.layout is not self.layout and state.layout != self.layout:
             raise DefinitionError("state belongs to another System (layouts differ)")
-        modeled, unmodeled, control, z_dot = self._generalized_forces(state)
-        rows = None
-        if self._fused:
-            rows = A, b = self._stack_rows(state, check_finite=False)
-            if 0 < b.size <= QR_MAX_ROWS:
-                V = state.V
-                n, s = A.shape[1], b.size
-                out = _empty(4 * n + s + 3)
-                if (
-                    V.dtype == _F64  # (not "is": arrays made by numba carry their own dtype object)
-                    and V.shape == self._V_shape
-                    and V.flags.c_contiguous
-                    and A.flags.c_contiguous
-                    and b.flags.c_contiguous
-                ):  # exactly the declared types: the compiled entry, no dispatch
-                    _uk_rigid_c(V, modeled, A, b, self._uk_params, out)
-                else:
-                    _uk_kernels.uk_rigid(V, modeled, A, b, self._uk_params, out)
-                status = float(out[-1])
-                if status == 3.0:
-                    self._check_consistency(state, float(out[-3]), float(out[-2]))
-                if status == 0.0 or status == 3.0:  # certified full row rank: solved
-                    return Accelerations._from_dict(
-                        {
-                            "layout": self.layout,
-                            "free": out[:n],
-                            "constraint": out[n : 2 * n],
-                            "extra": self._zero_loads,  # a fused System has no plant-only loads
-                            "total": out[2 * n : 3 * n],
-                            "constraint_force": out[3 * n : 4 * n],
-                            "control_force": control,
-                            "unmodeled_force": unmodeled,
-                            "multipliers": out[4 * n : 4 * n + s],
-                            "residual": float(out[-3]),
-                            "rank": s,
-                            "unreachable": 0.0,
-                            "z_dot": z_dot,
-                        }
-                    )
-        a = self._free(state, modeled)
-        if self._plant_only_loads:
-            extra = self._apply_Minv(unmodeled + control)
-            total = a + extra
-        else:
-            extra = np.zeros_like(a)
-            total = a.copy()
-        unreachable = 0.0
-        if self.tangent_bundle:
-            ac, lam, rank, residual, unreachable = self._solve_t2(state, a)
-        else:
-            ac, lam, rank, residual = self._solve_r6(state, a, rows)
-        total += ac
-        return Accelerations(
-            self.layout,
-            a,
-            ac,
-            extra,
-            total,
-            self._apply_M(ac),
-            control,
-            unmodeled,
-            lam,
-            residual,
-            rank,
-            unreachable,
-            z_dot,
-        )
-
-    def _solve_r6(
-        self, state: State, a: FloatArray, rows: tuple[Any, FloatArray] | None = None
-    ) -> tuple[FloatArray, FloatArray, int | None, float]:
-        A, b = self._stack_rows(state, check_finite=False) if rows is None else rows
-        values = np.asarray(A.data if sp.issparse(A) else A).reshape(-1)
-        if not (all_finite(values) and all_finite(b)):
-            self.constraint_rows(state)  # raises ConstraintError naming the constraint
-            raise ConstraintError(f"constraint rows at t = {state.t:.9g} s are not finite")
-        return self._solve_rows(state, a, A, b)
-
-    def _solve_rows(
-        self, state: State, a: FloatArray, A: Any, b: FloatArray
-    ) -> tuple[FloatArray, FloatArray, int | None, float]:
-        """UK solve of given rows, with the consistency check."""
-        if b.size == 0:
-            return np.zeros_like(a), np.zeros(0), 0, 0.0
-        status = 1
-        if self.sparse:
-            Aa = A @ a
-            ac, lam, rank = uk.solve_sparse(
-                sp.csr_matrix(A), b - Aa, self._Minv_sp, self._Minv_sqrt_sp, self.sparse_solver
-            )
-            residual = float(np.linalg.norm(A @ (a + ac) - b))
-            norm_Aa = float(np.linalg.norm(Aa))
-        else:
-            rcond = self.rcond if self.rcond is not None else max(A.shape) * _EPS
-            # Full row rank certified (κ(A M^{-1/2}) ≤ QR_COND_LIMIT): the QR solve gives the
-            # same ν̇_c and λ as the SVD for a fraction of the cost; otherwise the SVD.
-            status = 1
-            if A.shape[0] <= QR_MAX_ROWS:
-                ac, lam, residual, scale, status = _uk_kernels.uk_qr(
-                    A, b, a, self._Minv_sqrt, min(QR_COND_LIMIT, 0.1 / rcond)
-                )
-                rank = b.size
-            if status != 0:
-                ac, lam, rank, residual, norm_Aa = _uk_kernels.uk_dense(
-                    A, b, a, self._Minv_sqrt, rcond
-                )
-        if status != 0:
-            scale = max(1.0, float(np.sqrt(b @ b)), norm_Aa)
-        self._check_consistency(state, residual, scale)
-        return ac, lam, rank, residual
-
-    def _check_consistency(self, state: State, residual: float, scale: float) -> None:
-        """Warn (raise in strict mode) when ‖A ν̇ − b‖ exceeds consistency_tol × scale."""
-        if residual > self.consistency_tol * scale:
-            msg = (
-                f"constraints are inconsistent at t = {state.t:.9g} s: ‖A ν̇ − b‖ = "
-                f"{residual:.3g} (tolerance {self.consistency_tol:g} × {scale:.3g}); the "
-                "least-squares constraint acceleration was used"
-            )
-            if self.strict:
-                raise InconsistentConstraintsError(msg)
-            warnings.warn(msg, InconsistentConstraintsWarning, stacklevel=3)
-
-    def _solve_t2(
-        self, state: State, a: FloatArray
-    ) -> tuple[FloatArray, FloatArray, int | None, float, float]:
-        (c,) = self.constraints
-        assert isinstance(c, TangentBundleConstraint)
-        A, B, C = (np.asarray(x, dtype=float) for x in c.tangent_rows(state))
-        idx = [self.layout.slot(bd).index for bd in c.bodies]
-        if self.tangent_bundle_method == "reachable":
-            A6, b6 = uk.reachable_rows(A, B, C, state.g[idx], state.V[idx])
-            A_full = np.zeros((A6.shape[0], self.layout.n_dof))
-            A_full[:, self._rigid_idx[idx].ravel()] = A6
-            ac, lam, rank, residual = self._solve_rows(state, a, A_full, b6)
-            return ac, lam, rank, residual, 0.0
-        g = state.g[idx]
-        Vh = se3._hat(state.V[idx])
-        a_r = a[self._rigid_idx[idx]]
-        gdd_a = g @ (Vh @ Vh + se3._hat(a_r))
-        Im14 = self._I_tilde_m14_for(idx)
-        V_dot_c, unreachable, residual = uk.solve_tangent_bundle(A, B, C, g, gdd_a, Im14)
-        ac = np.zeros_like(a)
-        ac[self._rigid_idx[idx]] = V_dot_c
-        return ac, np.zeros(0), None, residual, unreachable
-
-    def _I_tilde_m14_for(self, rigid_indices: list[int]) -> FloatArray:
-        return scipy.linalg.block_diag(*[self._I_tilde_m14_blocks[i] for i in rigid_indices])
+        return self.solver.accelerations(state, *self._generalized_forces(state))
 
     # ------------------------------------------------------------------ simulation
     def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:
         """Integrate from ``state0`` over ``t_span``; see :func:`gmuk.integrate.simulate`."""
-        from gmuk.integrate import simulate
-
-        return simulate(self, state0, t_span, **options)
+        return _simulate(self, state0, t_span, **options)
 
     def __repr__(self) -> str:
         return (
             f"System(bodies={list(self.layout.names)}, constraints={len(self.constraints)}, "
             f"forces={len(self.forces)}, controllers={len(self.controllers)}, "
-            f"sparse={self.sparse})"
+            f"solver={self.solver.name!r})"
         )

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError, FileFormatError
 from gmuk.lie import euler, so3
 from gmuk.state import Layout
@@ -101,7 +102,8 @@ class Trajectory:
     @property
     def layout(self) -> Layout:
         """The body index of this trajectory."""
-        return Layout(self.body_names, self.body_kinds, self.body_dofs, self.z.shape[1])
+        kinds = tuple(BodyKind(k) for k in self.body_kinds)
+        return Layout(self.body_names, kinds, self.body_dofs, self.z.shape[1])
 
     @property
     def success(self) -> bool:

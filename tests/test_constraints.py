@@ -173,11 +173,23 @@ def test_tracking_constraint_b_is_eq_67_on_the_constraint_and_projected_off_it()
     assert np.allclose(b_off, np.concatenate([so3.vee(W), X[:3, 3]]), atol=1e-12)
 
 
-def test_tangent_bundle_system_takes_exactly_one_constraint():
+def test_eq80_takes_exactly_one_constraint_while_reachable_rows_stack():
     a = gmuk.RigidBody("a", 1.0, np.eye(3))
-    ref = ScrewReference(np.eye(4), np.zeros(6))
+    ref = ScrewReference(np.eye(4), np.array([0.01, 0.02, -0.03, 1.0, 0.0, 0.5]))
+    both = [gmuk.ConfigurationTrackingT2(a, ref), gmuk.ConfigurationTracking(a, ref)]
     with pytest.raises(gmuk.errors.DefinitionError, match="exactly one TangentBundleConstraint"):
-        gmuk.System([a], [gmuk.ConfigurationTrackingT2(a, ref), gmuk.ConfigurationTracking(a, ref)])
+        gmuk.System([a], both, tangent_bundle_method="eq80")
+    with pytest.raises(gmuk.errors.DefinitionError, match="exactly one TangentBundleConstraint"):
+        gmuk.System([a], [gmuk.ConfigurationTracking(a, ref)], tangent_bundle_method="eq80")
+    # On R⁶ the T²SE(3) rows stack with the tracking rows (consistent, redundant).
+    stacked = gmuk.System([a], both)
+    alone = gmuk.System([a], both[1:])
+    state = stacked.state(g={"a": ref.evaluate(0.0).g}, V={"a": ref.evaluate(0.0).V})
+    A, b = stacked.constraint_rows(state)
+    assert A.shape == (16 + 6, 6) and b.shape == (22,)  # A g̈ B = C: 4 × 4 rows
+    x, y = stacked.accelerations(state), alone.accelerations(state)
+    assert np.allclose(x.total, y.total, rtol=0, atol=1e-12)
+    assert x.residual <= 1e-12
 
 
 def test_baumgarte_drives_an_initial_tracking_error_to_zero():

@@ -199,7 +199,7 @@ def test_system_reports_every_definition_problem_at_once():
         "duplicate body name 'a'",
         "bodies[3]",
         "'ghost'",
-        "needs rigid bodies",
+        "acts on rigid bodies",
         "'nobody'",
     ):
         assert needle in text

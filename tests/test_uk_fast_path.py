@@ -12,6 +12,7 @@ import gmuk
 from gmuk import _uk_kernels
 from gmuk.errors import ConstraintError
 from gmuk.reference import ReferenceState, ReferenceTrajectory
+from gmuk.solvers import FusedRigidSolver
 
 EPS = np.finfo(float).eps
 
@@ -67,9 +68,10 @@ def test_qr_solve_declines_what_it_cannot_certify():
 
 
 def _general_path(system):
-    """The same System with the fused call switched off (the SVD path of every version)."""
-    system._fused = False
-    return system
+    """The same parts in a System with the dense solve strategy instead of the fused call."""
+    return gmuk.System(
+        system.bodies, system.constraints, system.forces, system.controllers, solver="dense"
+    )
 
 
 @pytest.mark.parametrize("n", [1, 2, 3])
@@ -82,7 +84,7 @@ def test_fused_call_equals_the_general_path_field_by_field(n):
     slow = _general_path(
         gmuk.System(bodies, [Rows(bodies, A, b)], forces=[gmuk.UniformGravity([0, 0, -9.8])])
     )
-    assert fast._fused
+    assert isinstance(fast.solver, FusedRigidSolver)
     state = random_state(fast, rng)
     x, y = fast.accelerations(state), slow.accelerations(state)
     for name in ("free", "constraint", "total", "constraint_force", "multipliers"):
@@ -171,13 +173,13 @@ def _values(acc):
 
 def _count_entry_calls(monkeypatch):
     calls = []
-    entry = gmuk.system._uk_rigid_c
+    entry = gmuk.solvers._uk_rigid_c
 
     def counted(*args):
         calls.append(1)
         entry(*args)
 
-    monkeypatch.setattr(gmuk.system, "_uk_rigid_c", counted)
+    monkeypatch.setattr(gmuk.solvers, "_uk_rigid_c", counted)
     return calls
 
 
@@ -196,7 +198,7 @@ def test_rows_in_any_memory_layout_give_the_results_of_contiguous_rows(monkeypat
     results = {}
     for label, (Ai, bi) in variants.items():
         system = gmuk.System(bodies, [Rows(bodies, Ai, bi)])
-        assert system._fused
+        assert isinstance(system.solver, FusedRigidSolver)
         state = random_state(system, np.random.default_rng(9))
         n_before = len(calls)
         results[label] = _values(system.accelerations(state))

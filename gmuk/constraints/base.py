@@ -11,13 +11,14 @@ from __future__ import annotations
 import abc
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 import scipy.sparse as sp
 
 from gmuk._frozen import FreezesInSystem
 from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind
 from gmuk.errors import ConstraintError, DefinitionError
 
 if TYPE_CHECKING:
@@ -62,9 +63,12 @@ class Baumgarte:
 class Constraint(FreezesInSystem, abc.ABC):
     """A set of s constraint rows ``A ν̇ = b`` on some bodies.
 
-    Subclass it and implement :meth:`rows`. The bodies are given as :class:`gmuk.Body`
-    objects or names; the System checks that they exist. A constraint is frozen once it is
-    handed to a System (its attributes can no longer be set).
+    Subclass it and implement :meth:`rows`: every constraint, whatever its kind, gives its
+    rows of ``A ν̇ = b`` (the System stacks them and solves them with its strategy). A kind
+    that needs more states it as class attributes, which the System checks once:
+    :attr:`body_kinds`, the kinds of body it can act on. The bodies are given as
+    :class:`gmuk.Body` objects or names; the System checks that they exist. A constraint is
+    frozen once it is handed to a System (its attributes can no longer be set).
 
     Parameters
     ----------
@@ -83,6 +87,8 @@ class Constraint(FreezesInSystem, abc.ABC):
     ...         return self.A, self.b
     """
 
+    #: The kinds of body this constraint can act on (default: every kind).
+    body_kinds: ClassVar[frozenset[BodyKind]] = frozenset(BodyKind)
     _bodies: tuple[Body | str, ...]
     _name: str
     _cached_indices: tuple[object, tuple[int, ...]] | None = None

@@ -23,6 +23,7 @@ import numpy as np
 
 from gmuk import _uk_kernels
 from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Baumgarte, Constraint
 from gmuk.errors import ConstraintError
 from gmuk.lie import se3
@@ -77,6 +78,8 @@ class RelativeConstraint(Constraint):
         ``alpha`` drives S V_{B/L} to S ∫a_des (zero by default) at rate α: velocity-level.
     name : str, optional
     """
+
+    body_kinds = frozenset({BodyKind.RIGID})
 
     def __init__(
         self,

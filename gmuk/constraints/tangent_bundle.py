@@ -1,10 +1,14 @@
 """Constraints on the double tangent bundle T²SE(3): ``A g̈ B = C`` (McCann 2020, Eq. 79).
 
 For n rigid bodies, ``g̈ = blkdiag(g̈₁, …, g̈ₙ)`` (4n × 4n), ``A`` is (m, 4n), ``B`` (4n, p) and
-``C`` (m, p). The System solves Eq. 80 for ``g̈_c`` and recovers the body accelerations
-``V̇_c,i = (g_i⁻¹ g̈_c,ii)^∨``. ERRATA: for general A, B the g̈_c of Eq. 80 need not lie in
-g·se(3) (no control input produces it); gmuk projects each diagonal block onto se(3) (skew
-rotation part, translation column) and reports the size of what it discarded.
+``C`` (m, p). Every reachable g̈ is ``g̈_i = g_i (V_i^² + V̇_i^)``, so the constraint is linear
+in the body accelerations: :meth:`TangentBundleConstraint.rows` gives those rows
+(:func:`gmuk.uk.reachable_rows`), which the System stacks and solves like any other
+constraint's. With ``System(..., tangent_bundle_method="eq80")`` the System instead solves
+Eq. 80 for ``g̈_c`` and recovers ``V̇_c,i = (g_i⁻¹ g̈_c,ii)^∨``. ERRATA: for general A, B the
+g̈_c of Eq. 80 need not lie in g·se(3) (no control input produces it); gmuk projects each
+diagonal block onto se(3) (skew rotation part, translation column) and reports the size of
+what it discarded.
 """
 
 from __future__ import annotations
@@ -15,10 +19,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Constraint
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3
 from gmuk.reference import ReferenceTrajectory
+from gmuk.uk import reachable_rows
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body
@@ -30,21 +36,30 @@ __all__ = ["ConfigurationTrackingT2", "TangentBundleConstraint", "VirtualPairT2"
 class TangentBundleConstraint(Constraint):
     """A constraint ``A g̈ B = C`` on the rigid bodies ``self.bodies`` (Eq. 79).
 
-    Subclasses implement :meth:`tangent_rows`. A System whose constraints are tangent-bundle
-    constraints is solved with Eq. 80 instead of Eq. 64; it takes exactly one such
+    Subclasses implement :meth:`tangent_rows`. Its R⁶ rows (:meth:`rows`) restrict the
+    constraint to reachable accelerations, so it stacks with any other constraint. Eq. 80
+    itself (``System(..., tangent_bundle_method="eq80")``) takes exactly one such
     constraint (Eq. 79 does not stack: write one A, B, C over all the bodies).
     """
+
+    body_kinds = frozenset({BodyKind.RIGID})
 
     @abc.abstractmethod
     def tangent_rows(self, state: State) -> tuple[Any, Any, Any]:
         """(A (m, 4k), B (4k, p), C (m, p)) at ``state`` for the k bodies of the constraint."""
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
-        """Not defined: a tangent-bundle constraint has no R⁶ rows (use the T²SE(3) solve)."""
-        raise DefinitionError(
-            f"{self.name} is a T²SE(3) constraint: it has no R⁶ rows A ν̇ = b; put it in a "
-            "System on its own (the System then solves McCann (2020) Eq. 80)"
-        )
+        """``A g̈ B = C`` on reachable accelerations, as rows on the bodies' twists.
+
+        Returns
+        -------
+        A6 : ndarray (m·p, 6k)
+        b6 : ndarray (m·p,)
+            See :func:`gmuk.uk.reachable_rows`.
+        """
+        A, B, C = (np.asarray(x, dtype=float) for x in self.tangent_rows(state))
+        idx = list(self._rigid_indices(state))
+        return reachable_rows(A, B, C, state.g[idx], state.V[idx])
 
 
 class ConfigurationTrackingT2(TangentBundleConstraint):

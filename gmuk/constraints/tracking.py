@@ -16,6 +16,7 @@ import numpy as np
 
 from gmuk import _uk_kernels
 from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Baumgarte, Constraint
 from gmuk.errors import ConstraintError, DefinitionError
 from gmuk.lie import se3
@@ -78,6 +79,8 @@ class ConfigurationTracking(Constraint):
     ----------
     McCann (2020), Eqs. (65)–(67); ERRATA for the projection off the constraint.
     """
+
+    body_kinds = frozenset({BodyKind.RIGID})
 
     def __init__(
         self,

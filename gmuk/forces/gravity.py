@@ -22,11 +22,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
 
 if TYPE_CHECKING:
-    from gmuk.bodies import Body
+    from gmuk.bodies import Body, RigidBody
 
 __all__ = ["GravityGradient", "PointMassGravity", "SphericalHarmonicGravity"]
 
@@ -58,14 +59,14 @@ class PointMassGravity(ForceModel):
         super().__init__(bodies, modeled=modeled)
         self.mu = _check_mu(mu)
 
-    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
-        """[0; m Rᵀ a_N] for a rigid body (N·m, N, body frame); m a_N for a point mass (N)."""
-        r = g_NB[:3, 3]
-        rn = float(np.sqrt(r @ r))
-        f_N = (-self.mu * body.mass / rn**3) * r  # type: ignore[attr-defined]
-        if body.kind == "rigid":
-            return np.concatenate([np.zeros(3), g_NB[:3, :3].T @ f_N])
-        return f_N
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
+        """[0; m Rᵀ a_N] in the body frame (N·m, N)."""
+        return np.concatenate([np.zeros(3), g_NB[:3, :3].T @ self.force(t, g_NB[:3, 3], V_B, body)])
+
+    def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
+        """−μ m r_N/|r_N|³ (N)."""
+        rn = float(np.sqrt(r_N @ r_N))
+        return (-self.mu * body.mass / rn**3) * r_N
 
 
 class GravityGradient(ForceModel):
@@ -96,13 +97,11 @@ class GravityGradient(ForceModel):
         super().__init__(bodies, modeled=modeled)
         self.mu = _check_mu(mu)
 
-    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
-        """[L_G; f_G] in the body frame (N·m, N), or the point-mass force for a particle."""
-        m = float(body.mass)  # type: ignore[attr-defined]
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
+        """[L_G; f_G] in the body frame (N·m, N)."""
+        m = body.mass
         r_N = g_NB[:3, 3]
-        if body.kind != "rigid":
-            return (-self.mu * m / float(np.sqrt(r_N @ r_N)) ** 3) * r_N
-        J = body.inertia  # type: ignore[attr-defined]
+        J = body.inertia
         r_B = g_NB[:3, :3].T @ r_N
         r2 = float(r_B @ r_B)
         rn = np.sqrt(r2)
@@ -111,6 +110,10 @@ class GravityGradient(ForceModel):
         shape = Jr + 0.5 * (np.trace(J) - 5.0 * float(r_B @ Jr) / r2) * r_B
         f = (-self.mu * m / (r2 * rn)) * (r_B + (3.0 / (m * r2)) * shape)
         return np.concatenate([L, f])
+
+    def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
+        """The point-mass force −μ m r_N/|r_N|³ on a particle (N)."""
+        return (-self.mu * body.mass / float(np.sqrt(r_N @ r_N)) ** 3) * r_N
 
 
 class SphericalHarmonicGravity(ForceModel):
@@ -174,18 +177,12 @@ class SphericalHarmonicGravity(ForceModel):
         self.include_finite_size_force = bool(finite_size_force)
         self._step = 2e-4 / (int(getattr(self.field, "degree", 0)) + 3)
 
-    def _fixed(self, t: float) -> tuple[FloatArray, FloatArray]:
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
+        """[L; f] in the body frame (N·m, N)."""
+        m = body.mass
         R_FN = self.central_body.rotation.R_FN(t)
-        return R_FN, R_FN.T
-
-    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
-        """[L; f] in the body frame (N·m, N), or f_N for a point mass (N)."""
-        m = float(body.mass)  # type: ignore[attr-defined]
-        R_FN, R_NF = self._fixed(t)
         r_F = R_FN @ g_NB[:3, 3]
-        if body.kind != "rigid":
-            return m * (R_NF @ self.field.acceleration(r_F))
-        J = body.inertia  # type: ignore[attr-defined]
+        J = body.inertia
         R_FB = R_FN @ g_NB[:3, :3]  # body components → F components
         both = getattr(self.field, "acceleration_hessian", None)  # one pass if the field can
         if both is not None:
@@ -200,7 +197,12 @@ class SphericalHarmonicGravity(ForceModel):
             f_B = f_B + R_FB.T @ self._finite_size_F(r_F, R_FB, J)
         return np.concatenate([L, f_B])
 
-    def finite_size_force(self, t: float, g_NB: FloatArray, body: Body) -> FloatArray:
+    def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
+        """m ∇U at r_N, in N (N)."""
+        R_FN = self.central_body.rotation.R_FN(t)
+        return body.mass * (R_FN.T @ self.field.acceleration(R_FN @ r_N))
+
+    def finite_size_force(self, t: float, g_NB: FloatArray, body: RigidBody) -> FloatArray:
         """The second-order finite-size force ``½ ∇³U : Π`` alone, in the body frame (N).
 
         It is what :meth:`wrench` adds to ``m ∇U(r)`` (and so what tests compare with a
@@ -215,12 +217,12 @@ class SphericalHarmonicGravity(ForceModel):
             Pose of the body in N (m).
         body : Body
         """
-        if body.kind != "rigid":
+        if body.kind is not BodyKind.RIGID:
             return np.zeros(3)
-        R_FN, _ = self._fixed(t)
+        R_FN = self.central_body.rotation.R_FN(t)
         r_F = R_FN @ g_NB[:3, 3]
         R_FB = R_FN @ g_NB[:3, :3]
-        return np.asarray(R_FB.T @ self._finite_size_F(r_F, R_FB, body.inertia))  # type: ignore[attr-defined]
+        return np.asarray(R_FB.T @ self._finite_size_F(r_F, R_FB, body.inertia))
 
     def _finite_size_F(self, r_F: FloatArray, R_FB: FloatArray, J: FloatArray) -> FloatArray:
         """``½ ∇(tr(H Π))`` at r_F in F components (N), Π = R_FB (½ tr J I − J) R_FBᵀ.

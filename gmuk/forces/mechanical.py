@@ -8,11 +8,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk._validation import FloatArray, as_array
+from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
 
 if TYPE_CHECKING:
-    from gmuk.bodies import Body
+    from gmuk.bodies import Body, RigidBody
     from gmuk.state import State
 
 __all__ = ["AppliedWrench", "SpringDamper", "UniformGravity"]
@@ -60,13 +61,18 @@ class AppliedWrench(ForceModel):
             self._fun = lambda t: w
         self.frame = frame
 
-    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
-        """The wrench at time t, in the body frame (or f_N for a point mass)."""
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
+        """The wrench [L; f] at time t, in the body frame (N·m, N)."""
         w = np.asarray(self._fun(t), dtype=float)
-        if body.kind == "rigid" and self.frame == "inertial":
+        if self.frame == "inertial":
             Rt = g_NB[:3, :3].T
             return np.concatenate([Rt @ w[:3], Rt @ w[3:]])
         return w
+
+    def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
+        """The force f_N at time t on a point mass (N); ``frame`` must be "inertial" or the
+        force is taken as given in N (a point mass has no body frame)."""
+        return np.asarray(self._fun(t), dtype=float)
 
 
 class UniformGravity(ForceModel):
@@ -89,12 +95,13 @@ class UniformGravity(ForceModel):
         super().__init__(bodies, modeled=modeled)
         self.g_N = as_array(g_N, (3,), "g_N", batch=False)
 
-    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
-        """[0; m Rᵀ g_N] for a rigid body, m g_N for a point mass."""
-        m = float(body.mass)  # type: ignore[attr-defined]
-        if body.kind == "rigid":
-            return np.concatenate([np.zeros(3), m * (g_NB[:3, :3].T @ self.g_N)])
-        return m * self.g_N
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
+        """[0; m Rᵀ g_N] in the body frame (N·m, N)."""
+        return np.concatenate([np.zeros(3), body.mass * (g_NB[:3, :3].T @ self.g_N)])
+
+    def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
+        """m g_N (N)."""
+        return body.mass * self.g_N
 
 
 class SpringDamper(ForceModel):
@@ -121,6 +128,8 @@ class SpringDamper(ForceModel):
     rest_length : float
         ℓ₀ (m), ≥ 0.
     """
+
+    acts_on = frozenset({BodyKind.RIGID, BodyKind.POINT})
 
     def __init__(
         self,
@@ -149,16 +158,12 @@ class SpringDamper(ForceModel):
         self.k, self.c, self.l0 = float(stiffness), float(damping), float(rest_length)
         self.anchored = body_b is None
 
-    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
-        """Not used: the spring couples two bodies, see :meth:`wrenches`."""
-        raise NotImplementedError  # pragma: no cover - wrenches() is overridden
-
     @staticmethod
     def _point(
         state: State, body: Body, p_B: FloatArray
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """World position and velocity of a body point, and its lever arm in N."""
-        if body.kind == "rigid":
+        if body.kind is BodyKind.RIGID:
             g, V = state.pose(body), state.twist(body)
             R = g[:3, :3]
             arm = R @ p_B
@@ -186,7 +191,7 @@ class SpringDamper(ForceModel):
 
     @staticmethod
     def _to_body(state: State, body: Body, p_B: FloatArray, f_N: FloatArray) -> FloatArray:
-        if body.kind != "rigid":
+        if body.kind is not BodyKind.RIGID:
             return f_N
         f_B = state.pose(body)[:3, :3].T @ f_N
         return np.concatenate([np.cross(p_B, f_B), f_B])

@@ -20,7 +20,7 @@ from gmuk.forces.base import ForceModel
 from gmuk.gravity.legendre import legendre_4pi
 
 if TYPE_CHECKING:
-    from gmuk.bodies import Body
+    from gmuk.bodies import Body, RigidBody
 
 __all__ = ["THESIS_NORMALIZATIONS", "ThesisRadialHarmonicGravity"]
 
@@ -232,22 +232,31 @@ class ThesisRadialHarmonicGravity(ForceModel):
             )
         return np.asarray(T)
 
-    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: Body) -> FloatArray:
-        """[L; f] in the body frame (N·m, N) by Eqs. 59 and 42; for a point mass, the
-        printed Eq. 25 force ``m a`` in N (N)."""
-        m = float(body.mass)  # type: ignore[attr-defined]
-        r_N = np.asarray(g_NB[:3, 3], dtype=float)
+    def _radial_terms(
+        self, t: float, r_N: FloatArray
+    ) -> tuple[FloatArray, float, float, FloatArray]:
+        """(n, μ/|r|³, |r|², (n+1) ρⁿ T_n for n ≥ 1) at r_N (m)."""
         R_FN = self.central_body.rotation.R_FN(t)
         T = self.degree_terms(R_FN @ r_N)
         r2 = float(r_N @ r_N)
         rn = float(np.sqrt(r2))
         n = self._n[1:]
         rho_n = (self.radius / rn) ** n
-        c = (n + 1.0) * rho_n * T[1:]  # (n+1) ρⁿ T_n, n ≥ 1
-        mu_r3 = self.mu / (r2 * rn)
-        if body.kind != "rigid":
-            return (-mu_r3 * m * (1.0 - float(np.sum(c)))) * r_N
-        J = body.inertia  # type: ignore[attr-defined]
+        return n, self.mu / (r2 * rn), r2, (n + 1.0) * rho_n * T[1:]
+
+    def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
+        """The printed Eq. 25 force ``m a`` on a point mass, in N (N)."""
+        r = np.asarray(r_N, dtype=float)
+        _, mu_r3, _, c = self._radial_terms(t, r)
+        return (-mu_r3 * body.mass * (1.0 - float(np.sum(c)))) * r
+
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
+        """[L; f] in the body frame (N·m, N) by Eqs. 59 and 42."""
+        m = body.mass
+        r_N = np.asarray(g_NB[:3, 3], dtype=float)
+        n, mu_r3, r2, c = self._radial_terms(t, r_N)  # c = (n+1) ρⁿ T_n, n ≥ 1
+        rn = float(np.sqrt(r2))
+        J = body.inertia
         r_B = g_NB[:3, :3].T @ r_N
         Jr = J @ r_B
         trJ = float(np.trace(J))

@@ -111,7 +111,7 @@ def load(name: str, degree: int | None = None) -> SphericalHarmonicField:
 def _check_int(degree: object) -> int:
     if not isinstance(degree, bool):
         try:
-            return operator.index(degree)  # type: ignore[call-overload]
+            return operator.index(degree)  # type: ignore[arg-type]
         except TypeError:
             pass
     raise DefinitionError(

@@ -96,13 +96,16 @@ class ThirdBodyGravity(ForceModel):
         self.mu = float(mu)
         self.ephemeris = ephemeris
 
+    def force(self, t: float, r_N: np.ndarray, v_N: np.ndarray, body: Any) -> np.ndarray:
+        """f_N on a point mass (N)."""
+        d = np.asarray(self.ephemeris(t), dtype=float)
+        return body.mass * third_body_acceleration(r_N, d, self.mu)
+
     def wrench(self, t: float, g_NB: np.ndarray, V_B: np.ndarray, body: Any) -> np.ndarray:
-        """[L; f] in the body frame for a rigid body, f_N for a point mass (N·m, N)."""
+        """[L; f] in the body frame for a rigid body (N·m, N)."""
         d = np.asarray(self.ephemeris(t), dtype=float)
         r = g_NB[:3, 3]
         f_N = body.mass * third_body_acceleration(r, d, self.mu)
-        if body.kind != "rigid":
-            return f_N
         R = g_NB[:3, :3]
         rho_B = R.T @ (d - r)
         n = float(np.linalg.norm(rho_B))

@@ -1,0 +1,440 @@
+"""Udwadia–Kalaba solve strategies, chosen once when a System is built.
+
+A :class:`UKSolver` turns a state's loads into :class:`gmuk.system.Accelerations`: the free
+acceleration ν̇_a = M⁻¹(ad*_V 𝕀V + Q), the constraint acceleration ν̇_c that the
+Udwadia–Kalaba equation gives for the stacked rows ``A ν̇ = b`` (McCann 2020, Eqs. 2, 64) or
+for ``A g̈ B = C`` on T²SE(3) (Eq. 80), the multipliers and the diagnostics. The System
+picks one strategy in its constructor (as scipy's ``Rotation`` picks its backend once) and
+calls it at every right-hand-side evaluation; nothing is decided per call except what the
+numbers decide (whether a QR factorisation certifies full row rank).
+
+Built in (names for ``System(..., solver=NAME)``):
+
+``"fused"`` (:class:`FusedRigidSolver`)
+    Small dense systems of rigid bodies whose loads the solve all sees: free acceleration,
+    Householder-QR solve and packing in one compiled call. Falls back to ``"dense"`` for a
+    call whose rows it cannot certify (more than :data:`QR_MAX_ROWS` rows, or a condition
+    number above the limit).
+``"dense"`` (:class:`DenseSolver`)
+    QR when full row rank is certified, else the SVD (minimum-norm, rank-revealing).
+``"sparse"`` (:class:`SparseSolver`)
+    Sparse rows; A M⁻¹ Aᵀ λ = r by SuperLU or conjugate gradients (:func:`gmuk.uk.solve_sparse`).
+``"eq80"`` (:class:`TangentBundleEq80Solver`)
+    McCann (2020) Eq. 80 as printed for one :class:`~gmuk.constraints.TangentBundleConstraint`,
+    with each body's block of g̈_c projected onto g·se(3).
+
+A new strategy is a subclass with a ``name``; it registers itself and ``System(...,
+solver=name)`` finds it.
+"""
+
+from __future__ import annotations
+
+import abc
+import enum
+import warnings
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+import scipy.linalg
+import scipy.sparse as sp
+
+from gmuk import _uk_kernels, uk
+from gmuk._numba import entry
+from gmuk._validation import FloatArray, all_finite
+from gmuk.bodies import RigidBody
+from gmuk.errors import (
+    ConstraintError,
+    DefinitionError,
+    InconsistentConstraintsError,
+    InconsistentConstraintsWarning,
+)
+from gmuk.lie import se3
+
+if TYPE_CHECKING:
+    from gmuk.state import State
+    from gmuk.system import Accelerations, System
+
+__all__ = [
+    "QR_COND_LIMIT",
+    "QR_MAX_ROWS",
+    "SOLVERS",
+    "DenseSolver",
+    "FusedRigidSolver",
+    "SolveStatus",
+    "SparseSolver",
+    "TangentBundleEq80Solver",
+    "UKSolver",
+]
+
+#: Dense solves: up to this many rows, a full-row-rank A is solved by Householder QR
+#: (compiled, no LAPACK set-up) when its condition number is certified ≤ QR_COND_LIMIT.
+QR_MAX_ROWS = 48
+QR_COND_LIMIT = 1e8
+_EPS = float(np.finfo(float).eps)
+_F64 = np.dtype(np.float64)
+_empty = np.empty
+_uk_rigid_c = entry(_uk_kernels.uk_rigid_c)
+
+#: Every registered strategy by name (subclasses with a ``name`` add themselves).
+SOLVERS: dict[str, type[UKSolver]] = {}
+
+
+class SolveStatus(enum.IntEnum):
+    """Outcome of a compiled QR solve (the kernels return it as a float)."""
+
+    #: Full row rank certified and solved.
+    SOLVED = 0
+    #: Rank not certified (too many rows, a zero pivot, or κ above the limit): use the SVD.
+    RANK_NOT_CERTIFIED = 1
+    #: A or b holds NaN or inf.
+    NOT_FINITE = 2
+    #: Solved, but ‖A ν̇ − b‖ is above the consistency tolerance.
+    INCONSISTENT = 3
+
+
+_SOLVED = float(SolveStatus.SOLVED)
+_INCONSISTENT = float(SolveStatus.INCONSISTENT)
+
+#: (ν̇_c (n,), λ (s,), rank or None, residual, unreachable)
+Solution = tuple[FloatArray, FloatArray, "int | None", float, float]
+
+
+class UKSolver(abc.ABC):
+    """One way of solving the Udwadia–Kalaba equation for a System.
+
+    Subclasses set ``name`` (registering the class in :data:`SOLVERS`) and ``sparse``
+    (whether the System should assemble sparse rows and mass blocks), may state what they
+    need of the System's parts in :meth:`problems`, and implement :meth:`solve`.
+
+    Parameters
+    ----------
+    system : System
+        The System being built; its mass blocks and index are in place.
+    """
+
+    name: ClassVar[str]
+    #: Whether this strategy works on sparse rows (``System.constraint_rows`` returns CSR).
+    sparse: ClassVar[bool] = False
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        name = cls.__dict__.get("name")
+        if isinstance(name, str):
+            SOLVERS[name] = cls
+
+    def __init__(self, system: System) -> None:
+        self.system = system
+
+    @classmethod
+    def problems(cls, system: System) -> list[str]:
+        """What this strategy cannot solve in ``system`` (empty if it can)."""
+        return []
+
+    def accelerations(
+        self,
+        state: State,
+        modeled: FloatArray,
+        unmodeled: FloatArray,
+        control: FloatArray,
+        z_dot: FloatArray,
+    ) -> Accelerations:
+        """Free, constraint and total accelerations from the generalized loads (n_dof,)."""
+        return self._general(state, modeled, unmodeled, control, z_dot, None)
+
+    def _general(
+        self,
+        state: State,
+        modeled: FloatArray,
+        unmodeled: FloatArray,
+        control: FloatArray,
+        z_dot: FloatArray,
+        rows: Any,
+    ) -> Accelerations:
+        from gmuk.system import Accelerations
+
+        system = self.system
+        a = system._free(state, modeled)
+        if system._plant_only_loads:
+            extra = system._apply_Minv(unmodeled + control)
+            total = a + extra
+        else:
+            extra = np.zeros_like(a)
+            total = a.copy()
+        ac, lam, rank, residual, unreachable = self.solve(state, a, rows)
+        total += ac
+        return Accelerations(
+            system.layout,
+            a,
+            ac,
+            extra,
+            total,
+            system._apply_M(ac),
+            control,
+            unmodeled,
+            lam,
+            residual,
+            rank,
+            unreachable,
+            z_dot,
+        )
+
+    @abc.abstractmethod
+    def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:
+        """The constraint acceleration for free acceleration ``a`` (n_dof,) at ``state``.
+
+        ``rows`` are the stacked (A, b) when the caller has them already. Returns
+        (ν̇_c (n_dof,), λ (s,), rank or None, residual, unreachable).
+        """
+
+    def check_consistency(self, state: State, residual: float, scale: float) -> None:
+        """Warn (raise in strict mode) when ‖A ν̇ − b‖ exceeds consistency_tol × scale."""
+        system = self.system
+        if residual > system.consistency_tol * scale:
+            msg = (
+                f"constraints are inconsistent at t = {state.t:.9g} s: ‖A ν̇ − b‖ = "
+                f"{residual:.3g} (tolerance {system.consistency_tol:g} × {scale:.3g}); the "
+                "least-squares constraint acceleration was used"
+            )
+            if system.strict:
+                raise InconsistentConstraintsError(msg)
+            warnings.warn(msg, InconsistentConstraintsWarning, stacklevel=4)
+
+    def _rows(self, state: State, rows: Any) -> tuple[Any, FloatArray]:
+        """The stacked rows, checked finite (naming the constraint that is not)."""
+        system = self.system
+        A, b = system._stack_rows(state, check_finite=False) if rows is None else rows
+        values = np.asarray(A.data if sp.issparse(A) else A).reshape(-1)
+        if not (all_finite(values) and all_finite(b)):
+            system.constraint_rows(state)  # raises ConstraintError naming the constraint
+            raise ConstraintError(f"constraint rows at t = {state.t:.9g} s are not finite")
+        return A, b
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+
+class DenseSolver(UKSolver):
+    """Dense rows: Householder QR where full row rank is certified, else the SVD.
+
+    The QR of ``(A M^{-1/2})ᵀ`` gives the same ν̇_c and λ as the SVD when A has full row
+    rank; the rank is certified from R (κ₂ bound ≤ min(QR_COND_LIMIT, 0.1/rcond), so the QR
+    never keeps a rank the SVD would drop). Otherwise the SVD gives the minimum-norm
+    least-squares solution and the numerical rank.
+    """
+
+    name = "dense"
+
+    def __init__(self, system: System) -> None:
+        super().__init__(system)
+        self._Minv_sqrt = system._Minv_sqrt
+
+    def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:
+        """QR or SVD solve of the stacked dense rows."""
+        A, b = self._rows(state, rows)
+        ac, lam, rank, residual = self.solve_rows(state, a, A, b)
+        return ac, lam, rank, residual, 0.0
+
+    def solve_rows(
+        self, state: State, a: FloatArray, A: FloatArray, b: FloatArray
+    ) -> tuple[FloatArray, FloatArray, int | None, float]:
+        """UK solve of given dense rows, with the consistency check."""
+        if b.size == 0:
+            return np.zeros_like(a), np.zeros(0), 0, 0.0
+        rcond = self.system.rcond
+        if rcond is None:
+            rcond = max(A.shape) * _EPS
+        if A.shape[0] <= QR_MAX_ROWS:
+            ac, lam, residual, scale, status = _uk_kernels.uk_qr(
+                A, b, a, self._Minv_sqrt, min(QR_COND_LIMIT, 0.1 / rcond)
+            )
+            if status == _SOLVED:
+                self.check_consistency(state, residual, scale)
+                return ac, lam, b.size, residual
+        ac, lam, rank, residual, norm_Aa = _uk_kernels.uk_dense(A, b, a, self._Minv_sqrt, rcond)
+        self.check_consistency(state, residual, max(1.0, float(np.sqrt(b @ b)), norm_Aa))
+        return ac, lam, rank, residual
+
+
+class FusedRigidSolver(DenseSolver):
+    """Small dense systems of rigid bodies only, every load seen by the solve.
+
+    One compiled call computes the free accelerations (Eq. 10b), the QR solve and the
+    constraint wrenches, with no per-call allocation beyond the result; a call whose rank it
+    cannot certify takes the :class:`DenseSolver` path with the same rows.
+    """
+
+    name = "fused"
+
+    def __init__(self, system: System) -> None:
+        super().__init__(system)
+        lay = system.layout
+        self._layout = lay
+        self._n = lay.n_dof
+        self._V_shape = (lay.n_rigid, 6)
+        self._zero_loads = system._zero_loads
+        # QR-eligible rows have s ≤ n, so the SVD's default rcond would be n·ε.
+        rc = system.rcond if system.rcond is not None else max(lay.n_dof, 1) * _EPS
+        self._params = _uk_kernels.rigid_params(
+            system._J,
+            system._Jinv,
+            system._m_rigid,
+            system._Minv_sqrt,
+            system._M_dense,
+            min(QR_COND_LIMIT, 0.1 / rc),
+            system.consistency_tol,
+        )
+
+    @classmethod
+    def problems(cls, system: System) -> list[str]:
+        """Rigid bodies only, no plant-only loads, at least one constraint."""
+        out = []
+        if system.layout.n_euclid:
+            out.append("the fused solve takes rigid bodies only")
+        if system._plant_only_loads:
+            out.append("the fused solve takes no unmodeled forces or controllers")
+        if not system.constraints:
+            out.append("the fused solve needs at least one constraint")
+        return out
+
+    def accelerations(
+        self,
+        state: State,
+        modeled: FloatArray,
+        unmodeled: FloatArray,
+        control: FloatArray,
+        z_dot: FloatArray,
+    ) -> Accelerations:
+        """The compiled path, or the dense one for rows it cannot certify."""
+        from gmuk.system import Accelerations
+
+        rows = A, b = self.system._stack_rows(state, check_finite=False)
+        s = b.size
+        if 0 < s <= QR_MAX_ROWS:
+            V = state.V
+            n = self._n
+            out = _empty(4 * n + s + 3)
+            if (
+                V.dtype == _F64  # (not "is": arrays made by numba carry their own dtype object)
+                and V.shape == self._V_shape
+                and V.flags.c_contiguous
+                and A.flags.c_contiguous
+                and b.flags.c_contiguous
+            ):  # exactly the declared types: the compiled entry, no dispatch
+                _uk_rigid_c(V, modeled, A, b, self._params, out)
+            else:
+                _uk_kernels.uk_rigid(V, modeled, A, b, self._params, out)
+            status = out[-1]
+            if status == _INCONSISTENT:
+                self.check_consistency(state, float(out[-3]), float(out[-2]))
+            if status == _SOLVED or status == _INCONSISTENT:
+                return Accelerations._from_dict(
+                    {
+                        "layout": self._layout,
+                        "free": out[:n],
+                        "constraint": out[n : 2 * n],
+                        "extra": self._zero_loads,  # no plant-only loads here
+                        "total": out[2 * n : 3 * n],
+                        "constraint_force": out[3 * n : 4 * n],
+                        "control_force": control,
+                        "unmodeled_force": unmodeled,
+                        "multipliers": out[4 * n : 4 * n + s],
+                        "residual": float(out[-3]),
+                        "rank": s,
+                        "unreachable": 0.0,
+                        "z_dot": z_dot,
+                    }
+                )
+        return self._general(state, modeled, unmodeled, control, z_dot, rows)
+
+
+class SparseSolver(UKSolver):
+    """Sparse rows (CSR): ``A M⁻¹ Aᵀ λ = b − A a`` by SuperLU (``method="lu"``) or by
+    Jacobi-preconditioned conjugate gradients (``"cg"``); see :func:`gmuk.uk.solve_sparse`."""
+
+    name = "sparse"
+    sparse = True
+
+    def __init__(self, system: System) -> None:
+        super().__init__(system)
+        self.method = system.sparse_solver
+
+    def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:
+        """Sparse solve of the stacked rows, with the consistency check."""
+        A, b = self._rows(state, rows)
+        if b.size == 0:
+            return np.zeros_like(a), np.zeros(0), 0, 0.0, 0.0
+        system = self.system
+        Aa = A @ a
+        ac, lam, rank = uk.solve_sparse(
+            sp.csr_matrix(A), b - Aa, system._Minv_sp, system._Minv_sqrt_sp, self.method
+        )
+        residual = float(np.linalg.norm(A @ (a + ac) - b))
+        scale = max(1.0, float(np.sqrt(b @ b)), float(np.linalg.norm(Aa)))
+        self.check_consistency(state, residual, scale)
+        return ac, lam, rank, residual, 0.0
+
+
+class TangentBundleEq80Solver(UKSolver):
+    """McCann (2020) Eq. 80 for one ``A g̈ B = C`` constraint on T²SE(3).
+
+    g̈_c = 𝕀̃^{-1/4} (A 𝕀̃^{-1/4})⁺ (C − A g̈_a B) (B 𝕀̃^{-1/4})⁺ 𝕀̃^{-1/4}; each body's diagonal
+    block is projected onto g·se(3) and ``Accelerations.unreachable`` reports the relative
+    size of what was discarded (ERRATA). No multipliers (Eq. 80 has none).
+    """
+
+    name = "eq80"
+
+    def __init__(self, system: System) -> None:
+        super().__init__(system)
+        (self._constraint,) = system.constraints
+        idx = [system.layout.slot(b).index for b in self._constraint.bodies]
+        self._idx = idx
+        self._cols = system._rigid_idx[idx]
+        bodies = [system._resolve(r) for r in self._constraint.bodies]
+        # 𝕀̃^{-1/4} = blkdiag(J^{-1/4}, m^{-1/4}) per body (rigid: the constraint declares it)
+        self._Im14 = scipy.linalg.block_diag(
+            *[
+                scipy.linalg.block_diag(uk.matrix_power_spd(b.inertia, -0.25), [[b.mass**-0.25]])
+                for b in bodies
+                if isinstance(b, RigidBody)
+            ]
+        )
+
+    @classmethod
+    def problems(cls, system: System) -> list[str]:
+        """Exactly one constraint, with ``tangent_rows`` (a TangentBundleConstraint)."""
+        from gmuk.constraints.tangent_bundle import TangentBundleConstraint
+
+        cs = system.constraints
+        if len(cs) == 1 and isinstance(cs[0], TangentBundleConstraint):
+            return []
+        kinds = [type(c).__name__ for c in cs]
+        return [
+            "solver 'eq80' (McCann 2020, Eq. 80) takes exactly one TangentBundleConstraint "
+            f"and no other constraint (Eq. 79 does not stack); got {kinds}"
+        ]
+
+    def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:
+        """Eq. 80 with the projection onto g·se(3)."""
+        c: Any = self._constraint
+        A, B, C = (np.asarray(x, dtype=float) for x in c.tangent_rows(state))
+        idx = self._idx
+        g = state.g[idx]
+        Vh = se3._hat(state.V[idx])
+        gdd_a = g @ (Vh @ Vh + se3._hat(a[self._cols]))
+        V_dot_c, unreachable, residual = uk.solve_tangent_bundle(A, B, C, g, gdd_a, self._Im14)
+        ac = np.zeros_like(a)
+        ac[self._cols] = V_dot_c
+        return ac, np.zeros(0), None, residual, unreachable
+
+
+def resolve(solver: object) -> type[UKSolver]:
+    """The strategy class for a name or a :class:`UKSolver` subclass."""
+    if isinstance(solver, type) and issubclass(solver, UKSolver):
+        return solver
+    if isinstance(solver, str) and solver in SOLVERS:
+        return SOLVERS[solver]
+    raise DefinitionError(
+        f"solver must be one of {sorted(SOLVERS)} or a gmuk.solvers.UKSolver subclass; "
+        f"got {solver!r}"
+    )
