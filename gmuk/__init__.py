@@ -9,9 +9,22 @@ The flow: parts (bodies, constraints, force models, controllers) → :class:`Sys
 :class:`Trajectory`.
 """
 
-from gmuk import errors, lie
-from gmuk.bodies import Body, PointMass, RigidBody, SlackCoordinate
-from gmuk.celestial import CelestialBody, UniformRotation
+from gmuk import (
+    constraints,
+    control,
+    dynamics,
+    errors,
+    forces,
+    gravity,
+    integrate,
+    lie,
+    orbits,
+    reference,
+    solvers,
+    uk,
+)
+from gmuk.bodies import Body, BodyKind, PointMass, RigidBody, SlackCoordinate
+from gmuk.celestial import INERTIAL, CelestialBody, UniformRotation
 from gmuk.constraints import (
     Baumgarte,
     ConfigurationTracking,
@@ -21,6 +34,7 @@ from gmuk.constraints import (
     NonholonomicConstraint,
     RelativeConstraint,
     TangentBundleConstraint,
+    VirtualPairT2,
 )
 from gmuk.control import Controller
 from gmuk.dynamics import spatial_inertia
@@ -29,10 +43,14 @@ from gmuk.forces import (
     ForceModel,
     GravityGradient,
     PointMassGravity,
+    SphericalHarmonicGravity,
     SpringDamper,
+    ThesisRadialHarmonicGravity,
     UniformGravity,
 )
+from gmuk.gravity import SphericalHarmonicField
 from gmuk.reference import ReferenceState, ReferenceTrajectory
+from gmuk.solvers import UKSolver
 from gmuk.state import Layout, State
 from gmuk.system import Accelerations, System
 from gmuk.trajectory import BodyTrajectory, Trajectory, load_trajectory
@@ -40,10 +58,12 @@ from gmuk.trajectory import BodyTrajectory, Trajectory, load_trajectory
 __version__ = "0.1.0"
 
 __all__ = [
+    "INERTIAL",
     "Accelerations",
     "AppliedWrench",
     "Baumgarte",
     "Body",
+    "BodyKind",
     "BodyTrajectory",
     "CelestialBody",
     "ConfigurationTracking",
@@ -62,16 +82,42 @@ __all__ = [
     "RelativeConstraint",
     "RigidBody",
     "SlackCoordinate",
+    "SphericalHarmonicField",
+    "SphericalHarmonicGravity",
     "SpringDamper",
     "State",
     "System",
     "TangentBundleConstraint",
+    "ThesisRadialHarmonicGravity",
     "Trajectory",
+    "UKSolver",
     "UniformGravity",
     "UniformRotation",
+    "VirtualPairT2",
     "__version__",
+    "constraints",
+    "control",
+    "dynamics",
     "errors",
+    "forces",
+    "gravity",
+    "integrate",
     "lie",
     "load_trajectory",
+    "orbits",
+    "reference",
+    "solvers",
     "spatial_inertia",
+    "uk",
 ]
+
+#: Submodules imported on first use (they pull in matplotlib, Pinocchio or the CLI).
+_LAZY = ("cli", "plotting", "scenarios")
+
+
+def __getattr__(name: str) -> object:
+    if name in _LAZY:
+        import importlib
+
+        return importlib.import_module(f"gmuk.{name}")
+    raise AttributeError(f"module 'gmuk' has no attribute {name!r}")

@@ -116,7 +116,8 @@ class CelestialBody:
             if rotation is None:
                 problems.append(
                     "a field needs a rotation model: pass rotation="
-                    "UniformRotation(rate) or rotation=INERTIAL explicitly"
+                    "gmuk.UniformRotation(rate) or rotation=gmuk.INERTIAL (also in "
+                    "gmuk.celestial) explicitly"
                 )
         if mu is None or not (np.isfinite(mu) and mu > 0):
             problems.append(f"mu must be a finite GM > 0 (m³/s²); got {mu!r}")

@@ -23,6 +23,7 @@ import numpy as np
 
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
+from gmuk.celestial import CelestialBody
 from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
 
@@ -116,6 +117,15 @@ class GravityGradient(ForceModel):
         return (-self.mu * body.mass / float(np.sqrt(r_N @ r_N)) ** 3) * r_N
 
 
+def _shipped_body(name: str, degree: int | None) -> CelestialBody:
+    """The central body of a shipped field, with that field (truncated to ``degree``)."""
+    from gmuk import gravity
+
+    field = gravity.load(name, degree)
+    body = next(i.body for i in gravity.available() if i.name.upper() == name.upper())
+    return CelestialBody.moon(field=field) if body == "Moon" else CelestialBody.earth(field=field)
+
+
 class SphericalHarmonicGravity(ForceModel):
     """Gravity of a central body's spherical-harmonic field on bodies, to second order in size.
 
@@ -139,14 +149,26 @@ class SphericalHarmonicGravity(ForceModel):
 
     Parameters
     ----------
-    central_body : CelestialBody
-        With a ``field`` (and its rotation model).
+    central_body : CelestialBody or str
+        A CelestialBody with a ``field`` (and its rotation model), or the name of a field
+        shipped with gmuk (``"GRGM660PRIM"``: the Moon, ``"EGM2008"``: the Earth; see
+        :func:`gmuk.gravity.available`), which gives that body with its default rotation
+        (:meth:`CelestialBody.moon`, :meth:`CelestialBody.earth`).
     degree : int, optional
         Truncate the field to this degree (default: the field's own).
     finite_size_force : bool
         Include the ½ ∇³U : Π force term (default True).
     bodies : sequence, optional
     modeled : bool
+
+    Examples
+    --------
+    The GRAIL lunar field to degree 50 on every body of a System, in one line:
+
+    >>> import gmuk
+    >>> moon_gravity = gmuk.SphericalHarmonicGravity("GRGM660PRIM", degree=50)
+    >>> moon_gravity.central_body.name, moon_gravity.field.degree
+    ('Moon', 50)
 
     Notes
     -----
@@ -165,12 +187,15 @@ class SphericalHarmonicGravity(ForceModel):
         modeled: bool = True,
     ) -> None:
         super().__init__(bodies, modeled=modeled)
+        if isinstance(central_body, str):
+            central_body = _shipped_body(central_body, degree)
+            degree = None  # already truncated on loading
         field = getattr(central_body, "field", None)
         if field is None:
             raise DefinitionError(
-                "SphericalHarmonicGravity needs a CelestialBody with a field; "
-                "load one with gmuk.gravity.load_gfc(...) and pass "
-                "CelestialBody.moon(field=...)"
+                "SphericalHarmonicGravity needs a CelestialBody with a field, or the name of "
+                "a shipped field (e.g. SphericalHarmonicGravity('GRGM660PRIM', degree=50)); "
+                f"got {central_body!r}"
             )
         self.central_body = central_body
         self.field = field if degree is None else field.truncate(degree)
