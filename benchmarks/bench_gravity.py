@@ -7,9 +7,9 @@ Run on demand (not a test):
 The script sets OMP_NUM_THREADS=1 and OPENBLAS_NUM_THREADS=1 itself, before numpy is
 imported, so that neither numpy nor pyshtools starts BLAS threads.
 
-Fields: GRGM660PRIM truncated to degrees 10 and 50, and to 150 (the shared file
-``GRGM660PRIM_to150.gfc``); degree 660 is synthetic (Kaula rule C̄, S̄ ~ N(0, (10⁻⁵/n²)²),
-seeded). Points lie 50-500 km above the Moon (reference radius 1738 km).
+Fields: GRGM660PRIM truncated to degrees 10 and 50, and to 150 (the whole file shipped
+with gmuk, ``gmuk.gravity.load("GRGM660PRIM")``); degree 660 is synthetic (Kaula rule
+C̄, S̄ ~ N(0, (10⁻⁵/n²)²), seeded). Points lie 50-500 km above the Moon (reference radius 1738 km).
 
 Single point, at one fixed position 200 km up:
 
@@ -29,7 +29,7 @@ Python loop of 1000 pyshtools calls (spherical coordinates precomputed).
 Per-call floor: what a compiled call from Python costs on this machine whatever the
 degree (an empty numba function with the signature of gmuk's single-point kernel, through
 numba's dispatcher and through the compiled entry gmuk uses; the allocation of the result
-array; ``np.array(r_F)``, the input copy gmuk made before 2026-11-23, for comparison),
+array; ``np.array(r_F)``, an input copy the single-point path avoids, for comparison),
 gmuk's compiled acceleration entry alone and the whole method at degrees 0 and 10, and
 pyshtools at degree 0.
 
@@ -39,7 +39,7 @@ largest relative difference is printed.
 
 Timing: each case's number of calls is chosen by ``timeit``'s ``autorange`` (≥ 0.2 s per
 run); then ``repeat`` rounds run every case once in turn (interleaved, so that a change of
-load on a shared machine hits every case alike), and each figure is the median over the
+load on a busy machine hits every case alike), and each figure is the median over the
 rounds. numba kernels are loaded (compiled if need be) and called once before timing.
 """
 
@@ -62,10 +62,8 @@ import numpy as np
 import pyshtools as pysh
 from numba import njit, types
 
-from gmuk.gravity import MOON_MU, MOON_RADIUS, SphericalHarmonicField, _kernels, load_gfc
+from gmuk.gravity import MOON_MU, MOON_RADIUS, SphericalHarmonicField, _kernels, load
 
-DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "gravity"
-GRAIL = DATA / "GRGM660PRIM_to150.gfc"
 BATCH = 1000
 DEGREES = (10, 50, 150, 660)
 #: Basilisk's spherical-harmonic model on this machine, as quoted in the issue (not run here).
@@ -161,7 +159,7 @@ def main() -> None:
     args = parser.parse_args()
     repeat = 3 if args.quick else 9
 
-    grail = load_gfc(GRAIL)
+    grail = load("GRGM660PRIM")
     fields = {N: (grail.truncate(N) if N < grail.degree else grail) for N in DEGREES[:3]}
     fields[660] = kaula_field(660, seed=0)
     rng = np.random.default_rng(0)

@@ -1,18 +1,169 @@
-"""Calling numba kernels without the dispatcher.
+"""numba for gmuk's kernels: where their compiled code is cached, and calls without dispatch.
 
-Numba's dispatcher resolves the types of a kernel's arguments on every call (≈ 0.3–0.8 µs
-here, growing with the number of arguments), more than the arithmetic of a small kernel.
-:func:`entry` returns the compiled function of a kernel that has one explicit signature;
-it skips that resolution and checks nothing beyond the Python type of each argument: arrays
+Cache location
+--------------
+gmuk's kernels are compiled with ``cache=True`` through :func:`njit`, which is
+:func:`numba.njit` with one addition: where the cache goes. numba keeps a function's cache
+in the ``__pycache__`` folder beside its source file when it can write there. When it cannot
+(an installation owned by another user, a read-only file system or image), gmuk's kernels
+are cached in a user cache folder instead:
+
+* POSIX: ``$XDG_CACHE_HOME/gmuk/numba``, or ``~/.cache/gmuk/numba`` when ``XDG_CACHE_HOME`` is
+  unset or not an absolute path (as the XDG specification asks);
+* Windows: ``%LOCALAPPDATA%\\gmuk\\numba``.
+
+A cache folder the user chose (``NUMBA_CACHE_DIR``, read by numba into
+``numba.config.CACHE_DIR``) is always left as it is. If neither the source folder nor the
+user cache folder is writable, the kernels are compiled without a cache (each process
+compiles them again) instead of failing to import.
+
+numba fixes a function's cache folder when the decorator runs (it builds the cache locator
+then; compilation and later loads use that folder). :func:`njit` therefore decides per
+kernel at decoration time and, when the user cache folder is needed, sets
+``numba.config.CACHE_DIR`` for the duration of the decoration only. The environment and the
+cache location of every other numba user in the process are left alone, and the import
+order of numba and gmuk does not matter.
+
+Calling without the dispatcher
+------------------------------
+numba's dispatcher resolves the types of a kernel's arguments on every call, which costs
+more than the arithmetic of a small kernel and grows with the number of arguments.
+:func:`entry` returns the compiled function of a kernel that has one explicit signature; it
+skips that resolution and checks nothing beyond the Python type of each argument: arrays
 must be exactly the declared types (dtype, number of dimensions, C-contiguity), or the
 kernel reads memory wrongly. Callers check that before taking such a path.
 """
 
 from __future__ import annotations
 
+import functools
+import inspect
+import os
+import sys
+import tempfile
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
-__all__ = ["entry"]
+import numba
+
+__all__ = ["cache_plan", "entry", "njit", "user_cache_dir"]
+
+#: numba's configuration module (its settings are attributes made at run time).
+_config: Any = numba.config
+
+
+def user_cache_dir(
+    environ: Mapping[str, str] | None = None, *, windows: bool | None = None
+) -> Path:
+    """The user cache folder for gmuk's compiled kernels (see the module docstring).
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        Environment variables to read (default ``os.environ``).
+    windows : bool, optional
+        Use the Windows convention (default: whether this is Windows).
+    """
+    env = os.environ if environ is None else environ
+    if windows is None:
+        windows = sys.platform == "win32"
+    if windows:
+        base = env.get("LOCALAPPDATA")
+        root = Path(base) if base else Path.home() / "AppData" / "Local"
+        return root / "gmuk" / "numba"
+    xdg = env.get("XDG_CACHE_HOME", "")
+    if xdg and os.path.isabs(xdg):
+        return Path(xdg) / "gmuk" / "numba"
+    home = env.get("HOME")
+    return (Path(home) if home else Path.home()) / ".cache" / "gmuk" / "numba"
+
+
+def _writable(folder: Path) -> bool:
+    """Whether ``folder`` exists or can be made, and a file can be created in it: the test
+    numba applies to a cache folder before it uses one."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError:
+        return False
+    return True
+
+
+def cache_plan(
+    source_dir: str | os.PathLike[str],
+    *,
+    configured: str = "",
+    environ: Mapping[str, str] | None = None,
+    windows: bool | None = None,
+) -> tuple[bool, str]:
+    """Whether to cache the kernels of one source folder, and where.
+
+    Parameters
+    ----------
+    source_dir : path-like
+        Folder of the kernels' source file; numba's own cache would be its ``__pycache__``.
+    configured : str
+        The cache folder configured for numba (``numba.config.CACHE_DIR``; empty if none).
+    environ, windows
+        As for :func:`user_cache_dir`.
+
+    Returns
+    -------
+    cache : bool
+        ``False`` only if no cache folder is writable.
+    directory : str
+        The folder to set as numba's cache folder while the kernel is decorated, or ``""``
+        to leave numba's choice alone: the configured folder, or ``__pycache__`` beside the
+        source when it is writable.
+    """
+    if configured or _writable(Path(source_dir) / "__pycache__"):
+        return True, ""
+    folder = user_cache_dir(environ, windows=windows)
+    if _writable(folder):
+        return True, str(folder)
+    return False, ""
+
+
+@functools.cache
+def _plan_for(source_dir: str, configured: str) -> tuple[bool, str]:
+    return cache_plan(source_dir, configured=configured)
+
+
+@contextmanager
+def _cache_dir(directory: str) -> Iterator[None]:
+    """numba's cache folder set to ``directory`` inside the block (unchanged if empty)."""
+    if not directory:
+        yield
+        return
+    before = _config.CACHE_DIR
+    _config.CACHE_DIR = directory
+    try:
+        yield
+    finally:
+        _config.CACHE_DIR = before
+
+
+def njit(*args: Any, **options: Any) -> Any:
+    """:func:`numba.njit`, with the cache of ``cache=True`` kernels placed as described in the
+    module docstring.
+
+    Takes numba's arguments and is used the same ways: ``@njit(signature, cache=True)``,
+    ``@njit(cache=True)``, ``njit(cache=True)(function)``.
+    """
+    if args and inspect.isfunction(args[0]):  # bare @njit
+        return njit(*args[1:], **options)(args[0])
+
+    def decorate(func: Callable[..., Any]) -> Any:
+        if not options.get("cache"):
+            return numba.njit(*args, **options)(func)
+        configured = str(_config.CACHE_DIR or "")
+        cache, directory = _plan_for(str(Path(inspect.getfile(func)).parent), configured)
+        with _cache_dir(directory):
+            return numba.njit(*args, **{**options, "cache": cache})(func)
+
+    return decorate
 
 
 def entry(kernel: Any) -> Any:

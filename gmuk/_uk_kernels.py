@@ -11,7 +11,9 @@ generic :func:`uk_rigid` otherwise.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
+from numba import types
+
+from gmuk._numba import njit
 
 _RO1 = types.Array(types.float64, 1, "C", readonly=True)
 _RO2 = types.Array(types.float64, 2, "C", readonly=True)
@@ -354,9 +356,9 @@ def uk_rigid(
     consistency_tol · scale`` (the caller warns or raises); the other entries are
     meaningful only for status 0 and 3. P from :func:`rigid_params`. Any array layout.
 
-    The caller allocates ``out``: a numba kernel that returns a new array pays ≈ 0.5 µs per
-    call to box it (it unpickles the array's dtype each time; numba 0.68), several times
-    what ``np.empty`` costs in Python.
+    The caller allocates ``out``: boxing an array that a numba kernel returns costs several
+    times what ``np.empty`` does in Python (numba unpickles the array's dtype on every
+    return).
     """
     _uk_rigid(V, Q, A, b, P, out)
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from gmuk._numba import njit
 from gmuk.errors import NonFiniteError, NotOnGroupError, ShapeError
 
 FloatArray = NDArray[np.float64]
@@ -61,8 +61,10 @@ def as_array(x: Any, tail: tuple[int, ...], name: str, *, batch: bool = True) ->
 
 @njit(cache=True)
 def all_finite(x: np.ndarray) -> bool:
-    """Whether every entry of a 1-D array is finite (compiled: ~0.2 µs for small arrays,
-    against ~1.7 µs for ``np.isfinite(x).all()``)."""
+    """Whether every entry of a 1-D array is finite.
+
+    Compiled: for the small arrays of single calls it is several times cheaper than
+    ``np.isfinite(x).all()``, which allocates a temporary and dispatches twice."""
     for v in x:
         if not np.isfinite(v):
             return False

@@ -8,7 +8,7 @@ the constraint rows ``A ν̇ = b``, the constraint acceleration is the Moore–P
 (McCann 2020, Eqs. 2 and 64), and the Lagrange multipliers ``λ = (A M⁻¹ Aᵀ)⁺ (b − A a)``
 (Eq. 3), so that the constraint force is ``Q_c = M ν̇_c = Aᵀ λ``. Sign convention: λ is
 Pinocchio's ``lambda_c`` and the negative of μ in the KKT system
-``[M Aᵀ; A 0][ν̇; μ] = [M a; b]`` (ERRATA).
+``[M Aᵀ; A 0][ν̇; μ] = [M a; b]`` (errata).
 """
 
 from __future__ import annotations
@@ -203,7 +203,7 @@ def reachable_rows(
     linear in ``V̇``: ``Σ_i A_i g_i V̇_i^ B_i = C − Σ_i A_i g_i V_i^² B_i``, with A_i, B_i the
     blocks of A, B belonging to body i. Solving these rows by Gauss's principle (Eq. 64)
     is the Udwadia–Kalaba solution of the T²SE(3) constraint within the reachable set; it
-    is the projection gmuk uses where Eq. 80's g̈_c is not reachable (ERRATA).
+    is the projection gmuk uses where Eq. 80's g̈_c is not reachable (errata).
 
     Parameters
     ----------

@@ -393,7 +393,7 @@ def test_f1_f2_limits_at_zero_and_the_errata_series_at_small_angles(impl):
     f1, f2 = impl(0.0)
     assert f1 == pytest.approx(1 / 12, rel=1e-15)
     assert f2 == pytest.approx(-1 / 720, rel=1e-15)
-    # ERRATA.md, "Numerically fragile": valid below θ ≈ 0.05 to 4e-16.
+    # docs/errata.rst, "Numerically fragile": valid below θ ≈ 0.05 to 4e-16.
     for t in [1e-8, 1e-5, 1e-3, 1e-2, 0.05]:
         f1, f2 = impl(t)
         s1 = 1 / 12 - t**4 / 30240 - t**6 / 604800

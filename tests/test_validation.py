@@ -2,7 +2,7 @@
 
 Every bad input raises the matching :mod:`gmuk.errors` class (ShapeError, NonFiniteError,
 NotOnGroupError, EulerSequenceError), which is also a ``ValueError``, with a message that
-states what was expected and what came in (DESIGN.md, Conventions 6).
+states what was expected and what came in (``docs/conventions.rst``, Errors).
 """
 
 from __future__ import annotations

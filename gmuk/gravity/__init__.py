@@ -79,12 +79,9 @@ formed, so terms that matter are never lost to underflow. No factorials are form
 anywhere; every coefficient is a square root of a ratio of small integers.
 
 The kernels are compiled with numba (``gmuk.gravity._kernels``; explicit signatures,
-cached on disk): the first import compiles them, 34-35 s on the project's shared 2-core
-machine (``python -c "import gmuk.gravity.field"`` with an empty ``NUMBA_CACHE_DIR``;
-27-28 s for the code before the flat workspace of low degrees, timed alternately with it),
-and later imports load them from the cache (2 s for the whole import). A field
-precomputes its recursion coefficients and square-root tables once, at construction or
-``truncate``.
+cached on disk, see :mod:`gmuk._numba` for where): the first import compiles them, which
+takes tens of seconds, and later imports load them from the cache. A field precomputes its
+recursion coefficients and square-root tables once, at construction or ``truncate``.
 
 Speed: a single position given as a float64 array of shape (3,) (any strides) takes a
 fast path: one compiled call without numba's type dispatch, which reads the position where
@@ -93,9 +90,9 @@ batches) goes through the batch kernel. Both run the same per-point code (compil
 each entry, the single-point ones with their request fixed), and the tests check that they
 agree bit for bit, across requests too (``acceleration`` and ``acceleration_hessian``).
 Rigid-body gravity wants ∇U and ∇∇U at every step: ``acceleration_hessian`` gives both
-from one pass, for 1.5–1.9× the cost of the acceleration alone. Measured medians on the
-shared 2-core machine, beside pyshtools 4.14 in the same run, are in
-``benchmarks/README.md`` (``python benchmarks/bench_gravity.py``).
+from one pass, for less than twice the cost of the acceleration alone. Timings beside
+pyshtools, measured in the same run, are in ``benchmarks/README.md``
+(``python benchmarks/bench_gravity.py``).
 
 Departures from McCann (2020)
 -----------------------------

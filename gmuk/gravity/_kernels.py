@@ -28,8 +28,8 @@ w⁰,w⁺,w⁻ ``L(N)`` each     weights of the gradient sums, packed as C (only
 with ``L(N) = (N+1)(N+2)/2``.
 
 Indices inside the loops are unsigned (``uint64``) so that no negative-index wraparound
-test is compiled into them (numba adds one for signed indices, which costs about a third
-of the time of these loops and prevents vectorisation).
+test is compiled into them: numba adds one for signed indices, a branch on every access
+that slows these loops substantially and prevents vectorisation.
 
 The gradient weights are products of f, h and G entries, stored so that the gradient
 sums, the bulk of an acceleration, do four multiplications fewer per term (computed in
@@ -49,23 +49,23 @@ and ten results (U, ∇U, and the upper triangle of the Hessian, row by row). Tw
 for bit, as the tests check):
 
 * flat, for ``W ≤`` :data:`FLAT_WIDTH` (degree ≤ 61 whatever the request): ``K = W``, column
-  j in slot j; every column is made first (at m = 0), then every sum. That was ≈ 10 %
-  faster than making the columns as the sums reach them at degrees 10-20, and a few per
-  cent or within the noise at 30-60 (compiled loops, throwaway A/B scripts; figures in
-  ``benchmarks/README.md``, Gravity);
+  j in slot j; every column is made first (at m = 0), then every sum. The recursion and
+  the sums then run as two separate tight loops, which is faster at low degree than
+  making each column when the sums reach it (figures in ``benchmarks/README.md``,
+  Gravity);
 * a ring above that: ``K = 8``, column j in slot ``j mod 8``, each column made when the
   sums first need it, so that the workspace stays small at high degree.
 
 :func:`evaluate` loops over points with one workspace; the ``*_at`` kernels are the
 single-point entries used by the public single-point calls. Workspaces of up to
 :data:`STACK_FLOATS` floats (any flat one; a ring up to degree 523) live on the stack of
-the calling kernel, larger ones on the heap (allocating and releasing one cost ≈ 50–70 ns
-per call, about what the whole degree-0 series costs).
+the calling kernel, larger ones on the heap: allocating and releasing a heap workspace on
+every call would cost about as much as a whole low-degree series.
 
 Calling without numba's dispatcher
 ----------------------------------
-Numba's dispatcher resolves argument types on every call (≈ 0.3–0.8 µs here, more than a
-degree-10 field costs to evaluate). :func:`entry` returns the compiled function of a
+Numba's dispatcher resolves argument types on every call, which costs more than
+evaluating a low-degree field. :func:`entry` returns the compiled function of a
 single-signature kernel, which skips that resolution; it does not check the arguments
 beyond their Python type, so callers must pass exactly the declared types (float64, the
 declared number of dimensions, C-contiguous except the single-point position, which may
@@ -78,11 +78,11 @@ import math
 
 import numpy as np
 from llvmlite import ir
-from numba import carray, njit, types, uint64
+from numba import carray, types, uint64
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gmuk._numba import entry  # re-exported: field.py calls kernels through it
+from gmuk._numba import entry, njit  # entry re-exported: field.py calls kernels through it
 from gmuk._validation import FloatArray
 
 __all__ = [
@@ -242,8 +242,8 @@ def _numba_owned(a):  # type: ignore[no-untyped-def]
     """A copy of ``a`` allocated by numba.
 
     numba passes such an array to a compiled function as is; for any other array it
-    allocates a wrapper on every call and frees it afterwards (≈ 20 ns of a single-point
-    call, the data vector being an argument of every one).
+    allocates a wrapper on every call and frees it afterwards, a cost every single-point
+    call would pay, the data vector being an argument of each.
     """
     return a.copy()
 
@@ -690,16 +690,14 @@ def _point_body(d, x, y, z, mode, Q, flat):  # type: ignore[no-untyped-def]
 
 #: :func:`_point_body` compiled on its own: the batch kernel and the potential entry call it
 #: with the mode and the layout known only at run time, the acceleration entries for a
-#: ring (degree 62 and up, where a call costs nothing beside the series) ...
+#: ring (degree 62 and up, where the series dominates the cost of a call) ...
 _point = njit(cache=True)(_point_body)
 #: ... and inlined into the acceleration entries for the flat layout, each of which fixes
 #: every mode bit but the central-term one: LLVM then drops the ring, the potential and the
-#: unused derivative code (the entry's machine code shrinks by about 40 %). Called from
-#: Python that made a degree-10 call faster, though a compiled loop over the two versions
-#: shows far less: a call from Python starts with cold caches and branch history, which
-#: favour smaller code (figures in benchmarks/README.md, Gravity). Inlining the ring as
-#: well (as 82d88a0 did) made the first import's compilation ≈ 10 s longer, for no speed
-#: that could be measured.
+#: unused derivative code. The smaller machine code makes a call from Python faster (such a
+#: call starts with cold caches and branch history), although a compiled loop barely shows
+#: the difference. The ring is not inlined: that lengthens the first import's compilation
+#: for no measurable speed (figures in benchmarks/README.md, Gravity).
 _point_inline = njit(cache=True, inline="always")(_point_body)
 
 
@@ -837,8 +835,8 @@ NOT_ONE_POINT = -1
 #
 # The two acceleration entries repeat their five lines of workspace and dispatch on
 # purpose: each needs its own inlined copy of the per-point code with its own constant
-# mode. Moving those lines into an inline="always" helper (inlining within inlining) made
-# the first import compile for 50-51 s instead of 31 s (timed alternately, 2026-11-23).
+# mode. Moving those lines into an inline="always" helper (inlining within inlining) makes
+# the first import's compilation much longer (benchmarks/README.md, Gravity).
 
 
 @njit(types.int64(_RO, _RA, _RW, types.boolean), cache=True)
@@ -850,7 +848,7 @@ def acceleration_at(d, r, out, central):  # type: ignore[no-untyped-def]
     Q, o, flat = _workspace(int(d[0]), mode)
     if flat:  # inlined, request and layout fixed
         code = _point_inline(d, r[0], r[1], r[2], mode, Q, True)
-    else:  # degree 62 and up: a call costs nothing beside the series
+    else:  # degree 62 and up: the series dominates the call
         code = _point(d, r[0], r[1], r[2], mode, Q, False)
     if code == OK:
         out[0] = Q[o + 1]
@@ -868,7 +866,7 @@ def acceleration_hessian_at(d, r, out, hess, central):  # type: ignore[no-untype
     Q, o, flat = _workspace(int(d[0]), mode)
     if flat:  # inlined, request and layout fixed
         code = _point_inline(d, r[0], r[1], r[2], mode, Q, True)
-    else:  # degree 62 and up: a call costs nothing beside the series
+    else:  # degree 62 and up: the series dominates the call
         code = _point(d, r[0], r[1], r[2], mode, Q, False)
     if code == OK:
         out[0] = Q[o + 1]

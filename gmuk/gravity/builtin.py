@@ -17,7 +17,8 @@ from the model's published coefficient table (the GRGM660PRIM distribution of th
 service and the PDS Geosciences Node, ``gggrx_0660pm_sha.tab``; Lemoine et al. 2013).
 The formal standard deviations of these coefficients are 1e-10 (C̄₂₀) to 7e-13, so the
 8-digit rounding (relative error ≤ 5e-8) is below or at their level. The test suite
-checks every typed value against the shared GRGM660PRIM file when that file is present.
+checks every typed value against the GRGM660PRIM file shipped with gmuk
+(``tests/gravity/test_gravity_builtin.py``).
 Frame: the DE421 principal-axis frame of the Moon.
 
 References

@@ -396,7 +396,7 @@ class SphericalHarmonicField:
 
     # ------------------------------------------------------------------ evaluation
 
-    def potential(self, r_F: Any, central: bool = True) -> float | FloatArray:
+    def potential(self, r_F: Any, *, central: bool = True) -> float | FloatArray:
         """Gravitational potential U at body-fixed positions (m²/s²; U > 0, a = +∇U).
 
         Parameters
@@ -420,10 +420,7 @@ class SphericalHarmonicField:
                 raise self._failure(code, r_F)
         return self._batch(_points(r_F), _POT, central).potential  # type: ignore[return-value]
 
-    # ``central`` of potential/acceleration/hessian is positional-or-keyword, not keyword-only:
-    # CPython fills keyword-only defaults on a slower path, ≈ 35–90 ns a call here, a tenth of
-    # a degree-10 single-point evaluation (benchmarks/README.md, Gravity).
-    def acceleration(self, r_F: Any, central: bool = True) -> FloatArray:
+    def acceleration(self, r_F: Any, *, central: bool = True) -> FloatArray:
         """Gravitational acceleration ∇U (full gradient) at body-fixed positions.
 
         Parameters
@@ -460,7 +457,7 @@ class SphericalHarmonicField:
                 raise self._failure(code, r_F)
         return self._batch(_points(r_F), _ACC, central).acceleration  # type: ignore[return-value]
 
-    def hessian(self, r_F: Any, central: bool = True) -> FloatArray:
+    def hessian(self, r_F: Any, *, central: bool = True) -> FloatArray:
         """Gravity-gradient tensor ∇∇U at body-fixed positions (1/s², frame F).
 
         Parameters
@@ -487,7 +484,9 @@ class SphericalHarmonicField:
             return H
         return self._batch(_points(r_F), _HES, central).hessian  # type: ignore[return-value]
 
-    def acceleration_hessian(self, r_F: Any, central: bool = True) -> tuple[FloatArray, FloatArray]:
+    def acceleration_hessian(
+        self, r_F: Any, *, central: bool = True
+    ) -> tuple[FloatArray, FloatArray]:
         """Acceleration ∇U and gravity-gradient tensor ∇∇U in one pass over the coefficients.
 
         What rigid-body gravity needs at every step (force and torque); the same numbers,
@@ -555,7 +554,8 @@ class SphericalHarmonicField:
             ``(potential, acceleration, hessian)``, ``None`` for what was not requested.
         """
         if hessian and acceleration and not potential:  # the rigid-body request
-            return _new_values(FieldValues, (None, *self.acceleration_hessian(r_F, central)))
+            both = self.acceleration_hessian(r_F, central=central)
+            return _new_values(FieldValues, (None, *both))
         mode = (_POT if potential else 0) | (_ACC if acceleration else 0)
         mode |= _HES if hessian else 0
         if not mode:

@@ -89,7 +89,12 @@ def load_gfc(path: str | os.PathLike[str], *, degree: int | None = None) -> Sphe
 
     Examples
     --------
-    >>> moon = load_gfc("../shared/data/gravity/GRGM660PRIM_to150.gfc", degree=50)  # doctest: +SKIP
+    The lunar field shipped with gmuk (:func:`gmuk.gravity.field_path` gives its path):
+
+    >>> from gmuk.gravity import field_path, load_gfc
+    >>> moon = load_gfc(field_path("GRGM660PRIM"), degree=50)
+    >>> moon.name, moon.degree, moon.mu, moon.radius
+    ('GRGM660PRIM', 50, 4902799806931.69, 1738000.0)
     """
     p = Path(path)
     lines = _read_lines(p)

@@ -31,8 +31,9 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit, types
+from numba import types
 
+from gmuk._numba import njit
 from gmuk._validation import FloatArray
 from gmuk.errors import DegreeError, DomainError, NonFiniteError, ShapeError
 from gmuk.gravity._kernels import BIG, BIGI

@@ -7,8 +7,8 @@ Where the closed form cancels catastrophically (θ → 0) a Taylor series in θ�
 ``_SERIES_BELOW`` (C) or ``_DE_SERIES_BELOW`` (D, E); the series converge for θ < 2π and
 are truncated where the next term is below 1e-20 relative at the switch-over, so both
 branches agree to round-off there.
-The series coefficients are exact rationals (derived symbolically; see ERRATA.md,
-"Numerically fragile", for F₁ and F₂ of McCann (2020), Eqs. 21–22).
+The series coefficients are exact rationals (derived symbolically; see the errata page,
+``docs/errata.rst``, "Numerically fragile", for F₁ and F₂ of McCann (2020), Eqs. 21–22).
 """
 
 from __future__ import annotations
@@ -22,8 +22,9 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 
 # NOTE: gmuk.lie._kernels freezes these constants into numba's on-disk cache, which is keyed on
-# _kernels.py only. After changing a constant here, touch _kernels.py (or clear its
-# __pycache__) so that the kernels recompile; the mpmath tests fail on stale kernels.
+# _kernels.py only (on its content in recent numba versions, so touching the file is not
+# enough). After changing a constant here, clear that cache (see gmuk._numba for where it
+# is) so that the kernels recompile; the mpmath tests fail on stale kernels.
 _SERIES_BELOW = 1.0
 
 # C(θ) = (θ − sin θ)/θ³ = Σ_k (−1)^k θ^{2k} / (2k+3)!

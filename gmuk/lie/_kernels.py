@@ -1,11 +1,11 @@
 """Compiled (numba) kernels for SO(3)/SE(3): the single implementation behind gmuk.lie.
 
 Every kernel takes flattened batches (leading axis n) and loops in machine code, so a single
-element costs about a microsecond instead of the tens of microseconds of chained numpy calls.
-The batch maps (``se3_exp``, ``compose_exp``, …) are thin Python functions that allocate
-their result and let a kernel (``_se3_exp_into``, …) fill it: a numba kernel that returns a
-new array pays ≈ 0.5 µs per call to box it (it unpickles the array's dtype each time; numba
-0.68), several times what ``np.empty`` costs.
+element costs one compiled call instead of a chain of numpy calls, each with its own
+overhead. The batch maps (``se3_exp``, ``compose_exp``, …) are thin Python functions that
+allocate their result and let a kernel (``_se3_exp_into``, …) fill it: boxing an array that
+a numba kernel returns costs several times what ``np.empty`` does (numba unpickles the
+array's dtype on every return).
 Formulas and series thresholds are documented in :mod:`gmuk.lie._coeffs` and in the public
 modules :mod:`gmuk.lie.so3`, :mod:`gmuk.lie.se3`.
 """
@@ -15,8 +15,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from gmuk._numba import njit
 from gmuk.lie._coeffs import _C_SERIES, _D_SERIES, _DE_SERIES_BELOW, _E_SERIES, _SERIES_BELOW
 
 _C = tuple(float(c) for c in _C_SERIES)  # highest power first (np.polyval order)

@@ -135,7 +135,7 @@ def log(g: Any) -> FloatArray:
     -------
     ndarray, shape (..., 6)
         ``ξ = [θ; ρ]`` with ``exp(ξ) = g``. McCann (2020) writes ``ξ = exp(g)^|`` below
-        Eq. 19; the map meant is this logarithm (ERRATA).
+        Eq. 19; the map meant is this logarithm (errata).
     """
     return _log(check_se3(g, "g"))
 
@@ -224,7 +224,7 @@ def dexp_inv(xi: Any) -> FloatArray:
 
     For ``g(t) = exp(ξ(t)^)`` moving with body twist ``V`` (``ġ = g V^``),
     ``ξ̇ = (I + ½ ad_ξ + F₁(θ) ad_ξ² + F₂(θ) ad_ξ⁴) V`` (McCann 2020, Eqs. 20–22, correct
-    as printed; ERRATA). This is Pinocchio's ``Jlog6`` at ``exp(ξ)``, reordered to [ω; v].
+    as printed; errata). This is Pinocchio's ``Jlog6`` at ``exp(ξ)``, reordered to [ω; v].
 
     Parameters
     ----------

@@ -1,5 +1,5 @@
 """Orbits: Kepler's equation for every conic, orbital elements ↔ state, Keplerian motion and
-the modified-LVLH reference trajectory of McCann (2020), Section 4.1.2 (corrected, ERRATA).
+the modified-LVLH reference trajectory of McCann (2020), Section 4.1.2 (corrected, errata).
 
 Modules
 -------

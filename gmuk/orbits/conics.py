@@ -8,7 +8,7 @@ perifocal frame P and the inertial frame N.
 References
 ----------
 McCann (2020), Section 4.1.2 (ḟ, f̈, v̇_{d/P} and Eqs. 75–78; all correct as printed, see
-ERRATA). Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed. (2013),
+errata). Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed. (2013),
 Ch. 2 (Kepler's problem for each conic).
 """
 

@@ -1,4 +1,5 @@
-"""The modified-LVLH reference motion of McCann (2020), Section 4.1.2, corrected per ERRATA.
+"""The modified-LVLH reference motion of McCann (2020), Section 4.1.2, corrected per the errata
+(``docs/errata.rst``).
 
 A spacecraft flies a Keplerian orbit with body axis 1 pointing at the central body
 (``b̂₁ = −r̂``), axis 3 along the orbit's angular momentum and axis 2 completing the
@@ -38,9 +39,9 @@ constraint force.
 References
 ----------
 McCann (2020), Section 4.1.2, Eqs. (68)–(78), and Section 4.3 (initial condition);
-``ERRATA.md`` (Eq. 69 transposed, Eq. 72 translational part, Eq. 74 signs, μ_Moon of
-Section 4.3). Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed. (2013),
-Ch. 2 (perifocal frame) and Ch. 3 (the satellite RSW frame).
+the errata page ``docs/errata.rst`` (Eq. 69 transposed, Eq. 72 translational part, Eq. 74
+signs, μ_Moon of Section 4.3). Vallado, *Fundamentals of Astrodynamics and Applications*,
+4th ed. (2013), Ch. 2 (perifocal frame) and Ch. 3 (the satellite RSW frame).
 """
 
 from __future__ import annotations
@@ -69,7 +70,7 @@ __all__ = [
 
 #: Lunar gravitational parameter (m³/s²) that makes the printed initial condition of
 #: McCann (2020), Section 4.3 (ḟ = 4.23818e-4 rad/s, v₂ = −1356.22 m/s at periapsis of the
-#: a = 4000 km, e = 0.2 orbit) consistent with the orbit (ERRATA). The usual value,
+#: a = 4000 km, e = 0.2 orbit) consistent with the orbit (errata). The usual value,
 #: 4.9028e12 m³/s², gives ḟ = 4.2373e-4 rad/s and v₂ = −1355.93 m/s instead.
 MU_MOON_THESIS_CONSISTENT = 4.9048695e12
 
@@ -91,7 +92,7 @@ def R_PD(f: Any) -> FloatArray:
 
     References
     ----------
-    McCann (2020), Eq. (69), which prints the transpose of this matrix (ERRATA).
+    McCann (2020), Eq. (69), which prints the transpose of this matrix (errata).
     """
     f = as_array(f, (), "f")
     c, s = np.cos(f), np.sin(f)
@@ -137,7 +138,7 @@ def compose_motion(
     * ``g_d = g_P g_{d/P}`` (Eq. 70)
     * ``V_d = V_{d/P} + Ad_{g_{d/P}⁻¹} V_P`` (Eq. 73)
     * ``V̇_d = V̇_{d/P} + Ad_{g_{d/P}⁻¹} V̇_P − ad_{V_{d/P}} Ad_{g_{d/P}⁻¹} V_P``
-      (Eq. 74 with the signs corrected, ERRATA).
+      (Eq. 74 with the signs corrected, errata).
 
     Derivation: ``ġ_d = g_P V_P^ g_{d/P} + g_P g_{d/P} V_{d/P}^``
     ``= g_d (Ad_{g_{d/P}⁻¹} V_P + V_{d/P})^``, and
@@ -162,7 +163,7 @@ def compose_motion(
 
     References
     ----------
-    McCann (2020), Eqs. (70), (73), (74); ERRATA (Eq. 74).
+    McCann (2020), Eqs. (70), (73), (74); errata (Eq. 74).
     """
     gP = check_se3(g_P, "g_P")
     gPD = check_se3(g_PD, "g_PD")
@@ -190,7 +191,7 @@ class LVLHReference(ReferenceTrajectory):
 
     Notes
     -----
-    The equations (McCann 2020, Eqs. 68–74 as corrected by ERRATA) are listed in the
+    The equations (McCann 2020, Eqs. 68–74 as corrected by the errata) are listed in the
     module docstring of :mod:`gmuk.orbits.lvlh`. The perifocal frame is inertial, so
     ``V_d = V_{d/P}`` and ``V̇_d = V̇_{d/P}``; in closed form, with ``r = p/(1 + e cos f)``
     and ``k = √(μ/p)``::
@@ -205,7 +206,7 @@ class LVLHReference(ReferenceTrajectory):
 
     References
     ----------
-    McCann (2020), Section 4.1.2, Eqs. (68)–(78); ERRATA.
+    McCann (2020), Section 4.1.2, Eqs. (68)–(78); errata.
     """
 
     def __init__(self, orbit: KeplerOrbit) -> None:
@@ -340,7 +341,7 @@ def fcei_orbit(mu: float = MU_MOON_THESIS_CONSISTENT) -> KeplerOrbit:
     ----------
     mu : float
         Gravitational parameter (m³/s²); defaults to :data:`MU_MOON_THESIS_CONSISTENT`,
-        the value that reproduces the printed initial condition (ERRATA).
+        the value that reproduces the printed initial condition (errata).
     """
     return KeplerOrbit.from_elements(4.0e6, 0.2, math.radians(35.0), 0.0, 0.0, mu)
 
@@ -354,7 +355,7 @@ def section43_initial_state(
     attitude. With ``μ = MU_MOON_THESIS_CONSISTENT`` this reproduces the printed numbers
     (``r = [3.2e6, 0, 0]`` m, ``R`` with entries ``−1, −0.81915, −0.57358, 0.81915``,
     ``ω₃ = ḟ = 4.23818e-4`` rad/s, ``v₂ = −1356.22`` m/s) to all printed digits; the
-    usual ``μ = 4.9028e12`` does not (ERRATA).
+    usual ``μ = 4.9028e12`` does not (errata).
 
     Parameters
     ----------
@@ -370,7 +371,7 @@ def section43_initial_state(
 
     References
     ----------
-    McCann (2020), Section 4.3 (initial conditions) and Eqs. (69)–(71); ERRATA.
+    McCann (2020), Section 4.3 (initial conditions) and Eqs. (69)–(71); errata.
     """
     ref = LVLHReference(fcei_orbit(mu)).evaluate(0.0)
     return ref.g, ref.V

@@ -34,20 +34,13 @@ Run with ``-s`` to print the measured figures quoted in docs/theory/chapter3.rst
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import mpmath as mp
 import numpy as np
 import pytest
 
 import gmuk
-from gmuk.gravity import SphericalHarmonicField, load_gfc
+from gmuk.gravity import SphericalHarmonicField, load
 from gmuk.lie import so3
-
-#: The shared GRAIL field (never copied into the repository).
-GRAIL_FILE = (
-    Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "gravity"
-) / "GRGM660PRIM_to150.gfc"
 
 #: Apollo LM mass properties, McCann (2020) §3.4 (kg, kg m², body frame).
 LM_MASS = 7063.0
@@ -63,10 +56,8 @@ ACCEPT = 1e-6  # issue #4: relative to the finite-size part (force) or the torqu
 
 @pytest.fixture(scope="module")
 def grail():
-    """GRGM660PRIM to degree 150 from the shared data folder (skipped if absent)."""
-    if not GRAIL_FILE.is_file():
-        pytest.skip(f"shared gravity file {GRAIL_FILE.resolve()} is absent")
-    return load_gfc(GRAIL_FILE)
+    """GRGM660PRIM to degree 150, shipped with gmuk."""
+    return load("GRGM660PRIM")
 
 
 # --------------------------------------------------------------------------- clouds

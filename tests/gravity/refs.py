@@ -15,17 +15,14 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import mpmath as mp
 import numpy as np
 
-from gmuk.gravity import MOON_MU, MOON_RADIUS, SphericalHarmonicField
+from gmuk.gravity import MOON_MU, MOON_RADIUS, SphericalHarmonicField, field_path
 
-#: The shared gravity data (never copied into the repository).
-DATA_DIR = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "gravity"
-GRAIL_FILE = DATA_DIR / "GRGM660PRIM_to150.gfc"
-EGM_FILE = DATA_DIR / "EGM2008_to70.gfc"
+#: The gravity files shipped in the package (``gmuk/gravity/data``).
+GRAIL_FILE = field_path("GRGM660PRIM")
+EGM_FILE = field_path("EGM2008")
 
 
 def kaula_field(N, seed=0, amplitude=1e-5, mu=MOON_MU, radius=MOON_RADIUS):

@@ -60,7 +60,7 @@ def test_single_point_equals_batch_of_one_bit_for_bit(field):
             assert U == field.potential(one, central=central)[0]
             H = field.hessian(r, central=central)
             np.testing.assert_array_equal(H, field.hessian(one, central=central)[0])
-            a2, H2 = field.acceleration_hessian(r, central)
+            a2, H2 = field.acceleration_hessian(r, central=central)
             np.testing.assert_array_equal(a2, a)
             np.testing.assert_array_equal(H2, H)
             ev = field.evaluate(r, potential=False, hessian=True, central=central)
@@ -223,14 +223,15 @@ def test_flat_and_ring_layouts_give_the_same_numbers_bit_for_bit(N):
             np.testing.assert_array_equal(flat[1], ring[1])
 
 
-def test_central_may_be_given_by_position_or_by_keyword():
+def test_central_is_keyword_only():
     field = kaula_field(10, seed=5, amplitude=1e-4)
     r = np.array([1.2e6, -0.9e6, 1.0e6])
-    for central in (True, False):
-        for method in (field.acceleration, field.hessian):
-            np.testing.assert_array_equal(method(r, central), method(r, central=central))
-        assert field.potential(r, central) == field.potential(r, central=central)
-    assert not np.array_equal(field.acceleration(r, False), field.acceleration(r))
+    methods = (field.potential, field.acceleration, field.hessian, field.acceleration_hessian)
+    for method in methods:
+        for pts in (r, r[None, :], list(r)):
+            with pytest.raises(TypeError, match="positional argument"):
+                method(pts, False)
+    assert not np.array_equal(field.acceleration(r, central=False), field.acceleration(r))
 
 
 def test_float64_vectors_of_any_stride_read_in_place_give_the_same_numbers():
@@ -265,11 +266,12 @@ def test_central_flag_is_read_by_truth_value_on_every_path():
     one = r[None, :]
     for flag in (True, False, 1, 0, np.bool_(True), np.bool_(False), None, 2.0):
         want = bool(flag)
-        np.testing.assert_array_equal(field.acceleration(r, flag), field.acceleration(one, want)[0])
-        a, H = field.acceleration_hessian(r, flag)
-        np.testing.assert_array_equal(a, field.acceleration(one, want)[0])
-        np.testing.assert_array_equal(H, field.hessian(one, want)[0])
-        assert field.potential(r, flag) == field.potential(one, want)[0]
+        a_one = field.acceleration(one, central=want)[0]
+        np.testing.assert_array_equal(field.acceleration(r, central=flag), a_one)
+        a, H = field.acceleration_hessian(r, central=flag)
+        np.testing.assert_array_equal(a, a_one)
+        np.testing.assert_array_equal(H, field.hessian(one, central=want)[0])
+        assert field.potential(r, central=flag) == field.potential(one, central=want)[0]
 
 
 def test_acceleration_hessian_of_batches_and_lists():
