@@ -91,7 +91,7 @@ class Accelerations:
     @classmethod
     def _from_dict(cls, fields: dict[str, Any]) -> Accelerations:
         # The frozen dataclass's __init__ sets 13 fields through object.__setattr__, a
-        # measurable share of a one-body call; the System passes every field, by name.
+        # noticeable share of a one-body call; the System passes every field, by name.
         obj = object.__new__(cls)
         object.__setattr__(obj, "__dict__", fields)
         return obj

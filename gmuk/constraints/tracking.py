@@ -104,8 +104,8 @@ class ConfigurationTracking(Constraint):
         g, V = state.g[i], state.V[i]
         ref = self.reference.evaluate(state.t)
         gd, Vd, Vd_dot = ref.g, ref.V, ref.V_dot
-        # np.asarray(x, dtype=float64) costs ≈ 0.3 µs even when x needs no conversion; compare
-        # dtypes with ==: arrays made by numba kernels carry their own float64 dtype object
+        # np.asarray costs more than this check when x needs no conversion; compare dtypes
+        # with ==: arrays made by numba kernels carry their own float64 dtype object
         if type(gd) is not _ndarray or gd.dtype != _F64:
             gd = np.asarray(gd, dtype=np.float64)
         if type(Vd) is not _ndarray or Vd.dtype != _F64:
