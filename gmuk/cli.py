@@ -1,127 +1,149 @@
-"""The ``gmuk`` command: list and run the thesis scenarios.
+"""The ``gmuk`` command: list and run the scenarios, check gmuk against Pinocchio.
 
     gmuk list
     gmuk plugins
-    gmuk run NAME [--orbits K] [--out DIR] [--no-plots] [--format png,pdf]
-    gmuk run apollo16 [--field PATH] [--degrees 2,10] [--model correct|thesis|both]
+    gmuk run [NAME] [--out DIR] [--no-plots] [--format png,pdf] [scenario options]
+    gmuk run NAME --help
+    gmuk check [--seed S] [--samples N] [--verbose]
 
 ``gmuk run`` writes ``DIR/trajectory.npz`` (loadable with :func:`gmuk.load_trajectory`),
 ``DIR/summary.json`` with the headline figures, the figures, and whatever further data the
-scenario writes (its ``write_data(result, out_dir)``, if it has one). ``--field``,
-``--degrees`` and ``--model`` go to scenarios whose ``run`` takes ``field_path``, ``degrees``
-and ``model`` (apollo16); giving them to another scenario is an error.
+scenario writes (its ``write_data``, if it has one). Without NAME it runs ``fcei``. The
+flags after NAME are the common ones above and the options the scenario declares
+(:class:`gmuk.scenarios.Option`; e.g. ``--orbits K``), listed by ``gmuk run NAME --help``;
+options not given take the scenario's defaults. A bad value stops with a message naming the
+flag and what came in, exit status 2.
+
+``gmuk check`` prints :func:`gmuk.check.check`'s table and exits 0 if every quantity agrees
+with Pinocchio within its tolerance, 1 if any does not.
 """
 
 from __future__ import annotations
 
 import argparse
-import inspect
 import json
 import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from types import ModuleType
 
 from gmuk import scenarios
 from gmuk.errors import GmukError
+from gmuk.scenarios import OptionError, Scenario
 
 __all__ = ["main"]
 
 DEFAULT_SCENARIO = "fcei"
+FORMATS = ("png", "pdf", "svg")
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="gmuk", description="List and run the thesis scenarios.")
-    sub = p.add_subparsers(dest="command")
+    p = argparse.ArgumentParser(
+        prog="gmuk", description="List and run the scenarios; check gmuk against Pinocchio."
+    )
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.add_parser("list", help="list the scenarios with one-line descriptions")
     sub.add_parser("plugins", help="list the installed force models (gmuk's and plugins')")
-    run = sub.add_parser("run", help="run a scenario and write its data and figures")
-    run.add_argument(
-        "name",
-        nargs="?",
-        default=DEFAULT_SCENARIO,
-        help=f"scenario name (default: {DEFAULT_SCENARIO}); see 'gmuk list'",
+    sub.add_parser(
+        "run",
+        help="run a scenario and write its data and figures; 'gmuk run NAME --help' lists "
+        "its options",
+        add_help=False,
     )
-    run.add_argument("--orbits", type=float, default=1.0, help="orbits to simulate (default 1)")
-    run.add_argument(
-        "--out", type=Path, default=None, help="output folder (default: ./gmuk-out/NAME)"
+    check = sub.add_parser(
+        "check",
+        help="cross-check gmuk's SE(3) operators and dynamics against Pinocchio",
+        description="Compare gmuk's Lie-group operators and rigid-body dynamics with "
+        "Pinocchio on seeded random inputs; exit status 1 if any quantity fails.",
     )
-    run.add_argument("--no-plots", action="store_true", help="write data only")
-    run.add_argument(
-        "--format",
-        default="png",
-        help="figure formats, comma-separated (default: png), e.g. png,pdf",
+    check.add_argument("--seed", type=int, default=0, help="seed of the inputs (default 0)")
+    check.add_argument(
+        "--samples", type=int, default=1000, help="samples per quantity (default 1000)"
     )
-    run.add_argument(
-        "--field",
-        type=Path,
-        default=None,
-        metavar="PATH",
-        help="gravity-field file (ICGEM .gfc) for scenarios that take one (apollo16: "
-        "degrees > 4 need it; default: $GMUK_GRAVITY_FIELD)",
-    )
-    run.add_argument(
-        "--degrees",
-        default=None,
-        help="harmonic degrees, comma-separated, for scenarios that take them (apollo16)",
-    )
-    run.add_argument(
-        "--model",
-        choices=("correct", "thesis", "both"),
-        default=None,
-        help="gravity model(s) for scenarios that take one (apollo16; default both)",
-    )
+    check.add_argument("--verbose", action="store_true", help="print each row as computed")
     return p
 
 
-def _scenario_options(module: ModuleType, args: argparse.Namespace) -> dict[str, object]:
-    """The scenario-specific options given on the command line, checked against ``run``."""
-    given: dict[str, object] = {}
-    if args.field is not None:
-        given["field_path"] = args.field
-    if args.degrees is not None:
-        try:
-            given["degrees"] = tuple(int(d) for d in args.degrees.split(",") if d.strip())
-        except ValueError:
-            raise GmukError(
-                f"--degrees takes comma-separated integers, e.g. 2,10; got {args.degrees!r}"
-            ) from None
-    if args.model is not None:
-        given["model"] = args.model
-    params = inspect.signature(module.run).parameters
-    flags = {"field_path": "--field", "degrees": "--degrees", "model": "--model"}
-    unused = [flags[k] for k in given if k not in params]
-    if unused:
-        raise GmukError(f"scenario {args.name!r} does not take {', '.join(unused)}")
-    return given
+def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
+    """``gmuk run NAME``'s parser: the common flags, then the scenario's declared options."""
+    names = ", ".join(s.name for s, _ in scenarios.available())
+    p = argparse.ArgumentParser(
+        prog=f"gmuk run {scenario.name}",
+        description=scenario.description,
+        allow_abbrev=False,
+        epilog=f"Scenarios: {names} ('gmuk list'). Without NAME, 'gmuk run' runs "
+        f"{DEFAULT_SCENARIO}.",
+    )
+    common = p.add_argument_group("output")
+    common.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help=f"output folder (default: ./gmuk-out/{scenario.name})",
+    )
+    common.add_argument("--no-plots", action="store_true", help="write data only")
+    common.add_argument(
+        "--format",
+        default="png",
+        metavar="FMT[,FMT]",
+        help=f"figure formats, comma-separated, of {', '.join(FORMATS)} (default: png)",
+    )
+    own = p.add_argument_group(f"{scenario.name} options")
+    for option in scenario.options:
+        own.add_argument(
+            option.flag,
+            dest=f"option:{option.name}",
+            default=None,
+            metavar="{" + ",".join(map(str, option.choices)) + "}"
+            if option.choices
+            else option.name.upper(),
+            help=option.help_text.replace("%", "%%"),
+        )
+    return p
 
 
-def _run(args: argparse.Namespace) -> int:
-    module = scenarios.load(args.name)
-    if not args.orbits > 0:
-        raise GmukError(f"--orbits must be > 0; got {args.orbits}")
+def _run(argv: Sequence[str]) -> int:
+    argv = list(argv)
+    name = argv.pop(0) if argv and not argv[0].startswith("-") else DEFAULT_SCENARIO
+    scenario = scenarios.get(name)
+    args, unknown = _run_parser(scenario).parse_known_args(argv)
+    if unknown:
+        flags = ", ".join(o.flag for o in scenario.options) or "none"
+        raise OptionError(
+            f"scenario {scenario.name!r} does not take {' '.join(unknown)}; its options: "
+            f"{flags} (gmuk run {scenario.name} --help)"
+        )
     formats = tuple(f.strip().lower() for f in args.format.split(",") if f.strip())
-    bad = [f for f in formats if f not in ("png", "pdf", "svg")]
+    bad = [f for f in formats if f not in FORMATS]
     if bad or not formats:
-        raise GmukError(f"--format takes png, pdf or svg (comma-separated); got {args.format!r}")
-    options = _scenario_options(module, args)
-    out = args.out or Path("gmuk-out") / args.name.lower()
+        raise OptionError(
+            f"--format takes {', '.join(FORMATS)} (comma-separated); got {args.format!r}"
+        )
+    given = {
+        key.partition(":")[2]: value
+        for key, value in vars(args).items()
+        if key.startswith("option:") and value is not None
+    }
+    options = scenario.parse_options(given)
+    out = args.out or Path("gmuk-out") / scenario.name
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    result = module.run(orbits=args.orbits, **options)
+    result = scenario.run(**options)
     elapsed = time.perf_counter() - t0
     path = result.trajectories[result.primary].save(out / "trajectory.npz")
     summary = {
         "scenario": result.name,
-        "orbits": args.orbits,
+        "options": {k: list(v) if isinstance(v, tuple) else v for k, v in options.items()},
+        **({"orbits": options["orbits"]} if "orbits" in options else {}),
         "wall_time_s": elapsed,
         **result.summary,
     }
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
-    extra = module.write_data(result, out) if hasattr(module, "write_data") else []
-    figures = [] if args.no_plots else module.figures(result, out, formats)
-    print(f"{result.name}: {args.orbits:g} orbit(s) in {elapsed:.2f} s")
+    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str) + "\n")
+    extra = scenario.write_data(result, out) if scenario.write_data is not None else []
+    figures = [] if args.no_plots else scenario.figures(result, out, formats)
+    shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)
+    print(f"{result.name}{f' ({shown})' if shown else ''}: {elapsed:.2f} s")
     for key, value in result.summary.items():
         print(f"  {key}: {value:.6g}" if isinstance(value, float) else f"  {key}: {value}")
     data = f", {len(extra)} further data file(s)" if extra else ""
@@ -129,16 +151,29 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check(args: argparse.Namespace) -> int:
+    from gmuk.check import check
+
+    report = check(seed=args.seed, n=args.samples, verbose=args.verbose)
+    print(report)
+    return 0 if report.ok else 1
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``gmuk`` console script; returns the exit status."""
-    args = _parser().parse_args(argv)
+    """Entry point of the ``gmuk`` console script; returns the exit status (0 success, 1
+    ``gmuk check`` found a disagreement, 2 bad input)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
     try:
+        if argv[:1] == ["run"]:
+            return _run(argv[1:])
+        args = _parser().parse_args(argv)
         if args.command == "list":
-            for name, text in scenarios.describe():
-                print(f"{name:<8} {text}")
+            for scenario, source in scenarios.available():
+                origin = "" if source == "gmuk" else f" [plugin: {source}]"
+                print(f"{scenario.name:<8} {scenario.description}{origin}")
             return 0
-        if args.command == "run":
-            return _run(args)
+        if args.command == "check":
+            return _check(args)
         if args.command == "plugins":
             from gmuk.forces import registry
 

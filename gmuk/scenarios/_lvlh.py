@@ -20,7 +20,7 @@ from gmuk import plotting
 from gmuk._validation import FloatArray
 from gmuk.lie import se3
 from gmuk.orbits import MU_MOON_THESIS_CONSISTENT, KeplerOrbit, LVLHReference
-from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import Option, ScenarioResult, positive_float
 from gmuk.trajectory import Trajectory
 
 #: Mass (kg) and central inertia (kg·m², body frame) of McCann (2020), Section 3.4.
@@ -38,6 +38,10 @@ MU = MU_MOON_THESIS_CONSISTENT
 #: would give 6.1e-7 m at 1030 (``benchmarks/bench_fcei.py``), too close to the 1e-6 m target.
 RTOL, ATOL = 3e-15, 1e-12
 SAMPLES_PER_ORBIT = 721
+#: The one option of every Chapter 4 scenario.
+ORBITS = Option(
+    "orbits", positive_float, 1.0, "orbits to simulate, in periods of the reference orbit"
+)
 
 
 def spacecraft(name: str = "spacecraft") -> gmuk.RigidBody:

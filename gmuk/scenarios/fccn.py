@@ -6,19 +6,18 @@ a = 4000 km, e = 0, i = 0. On a circular orbit the constraint wrench is constant
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from gmuk.orbits import fccn_orbit
-from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import Scenario, ScenarioResult
 from gmuk.scenarios import _lvlh as common
 
 NAME = "fccn"
 DESCRIPTION = "fully constrained LVLH tracking on a circular equatorial orbit, a = 4000 km"
 
 
-def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
+def run(orbits: float = 1.0) -> ScenarioResult:
     """Simulate ``orbits`` orbits."""
     orbit = fccn_orbit(common.MU)
     traj = common.fully_constrained(orbit, orbits)
@@ -44,3 +43,6 @@ def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
 def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
     """Position, velocity, Euler angles, body rates, constraint accelerations."""
     return common.figures_for(result, out, formats)
+
+
+SCENARIO = Scenario(NAME, DESCRIPTION, run, figures, options=(common.ORBITS,))

@@ -7,17 +7,16 @@ attitude (axis 1 at the Moon, axis 3 along the orbit normal) by Eq. 67 rows, A =
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from gmuk.orbits import fcei_orbit
-from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import Scenario, ScenarioResult
 from gmuk.scenarios import _lvlh as common
 
 NAME = "fcei"
 DESCRIPTION = "fully constrained LVLH tracking, a = 4000 km, e = 0.2, i = 35° (Eq. 67, R⁶)"
 
 
-def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
+def run(orbits: float = 1.0) -> ScenarioResult:
     """Simulate ``orbits`` orbits from periselene."""
     orbit = fcei_orbit(common.MU)
     traj = common.fully_constrained(orbit, orbits)
@@ -27,3 +26,6 @@ def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
 def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
     """Position, velocity, Euler angles, body rates, constraint accelerations."""
     return common.figures_for(result, out, formats)
+
+
+SCENARIO = Scenario(NAME, DESCRIPTION, run, figures, options=(common.ORBITS,))

@@ -5,19 +5,18 @@ accelerations to round-off, so the difference is integration noise)."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from gmuk.orbits import fcei_orbit
-from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import Scenario, ScenarioResult
 from gmuk.scenarios import _lvlh as common
 
 NAME = "fceim"
 DESCRIPTION = "FCEI on T²SE(3) (A g̈ B = C, Eq. 80), compared with FCEI on R⁶"
 
 
-def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
+def run(orbits: float = 1.0) -> ScenarioResult:
     """Simulate both formulations over ``orbits`` orbits."""
     orbit = fcei_orbit(common.MU)
     t2 = common.fully_constrained(orbit, orbits, tangent=True)
@@ -36,3 +35,6 @@ def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
 def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
     """FCEIM's figure groups and FCEIM − FCEI."""
     return common.figures_for(result, out, formats, [(NAME, "fcei", True)])
+
+
+SCENARIO = Scenario(NAME, DESCRIPTION, run, figures, options=(common.ORBITS,))

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from gmuk.orbits import fcei_orbit
-from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import Scenario, ScenarioResult
 from gmuk.scenarios import _lvlh as common
 
 NAME = "ucei"
@@ -48,7 +48,7 @@ def pair_summary(pair: Any, fcei: Any, orbit: Any) -> dict[str, Any]:
     }
 
 
-def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
+def run(orbits: float = 1.0) -> ScenarioResult:
     """Simulate the pair and FCEI over ``orbits`` orbits."""
     orbit = fcei_orbit(common.MU)
     pair = common.virtual_pair(orbit, orbits)
@@ -59,3 +59,6 @@ def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
 def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
     """The spacecraft's figure groups and UCEI − FCEI."""
     return common.figures_for(result, out, formats, [(NAME, "fcei", True)])
+
+
+SCENARIO = Scenario(NAME, DESCRIPTION, run, figures, options=(common.ORBITS,))

@@ -17,7 +17,7 @@ import numpy as np
 import gmuk
 from gmuk.constraints import VirtualPairT2
 from gmuk.orbits import LVLHReference, fcei_orbit
-from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import Scenario, ScenarioResult
 from gmuk.scenarios import _lvlh as common
 
 NAME = "uceim"
@@ -34,7 +34,7 @@ def _pair_t2(orbit: Any, method: str) -> gmuk.System:
     )
 
 
-def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
+def run(orbits: float = 1.0) -> ScenarioResult:
     """Simulate the T²SE(3) pair and UCEI over ``orbits`` orbits."""
     orbit = fcei_orbit(common.MU)
     system = _pair_t2(orbit, "reachable")
@@ -78,3 +78,6 @@ def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
 def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
     """The spacecraft's figure groups and UCEIM − UCEI."""
     return common.figures_for(result, out, formats, [(NAME, "ucei", True)])
+
+
+SCENARIO = Scenario(NAME, DESCRIPTION, run, figures, options=(common.ORBITS,))

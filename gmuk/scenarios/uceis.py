@@ -4,12 +4,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from gmuk.orbits import fcei_orbit
-from gmuk.scenarios import ScenarioResult
+from gmuk.scenarios import Scenario, ScenarioResult
 from gmuk.scenarios import _lvlh as common
 from gmuk.scenarios.ucei import pair_summary
 
@@ -18,7 +17,7 @@ DESCRIPTION = "UCEI plus the roll torque 0.005 sin f N·m: roll responds, the or
 TORQUE_AMPLITUDE = 0.005  # N·m
 
 
-def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
+def run(orbits: float = 1.0) -> ScenarioResult:
     """Simulate the torqued pair and FCEI over ``orbits`` orbits."""
     orbit = fcei_orbit(common.MU)
 
@@ -34,3 +33,6 @@ def run(orbits: float = 1.0, **_: Any) -> ScenarioResult:
 def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
     """The spacecraft's figure groups and UCEIS against FCEI (overlaid)."""
     return common.figures_for(result, out, formats, [(NAME, "fcei", False)])
+
+
+SCENARIO = Scenario(NAME, DESCRIPTION, run, figures, options=(common.ORBITS,))

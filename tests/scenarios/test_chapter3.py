@@ -1,42 +1,34 @@
-"""Chapter 3 scenario (apollo16): short runs here, the full orbit with the GRAIL file is `slow`.
+"""Chapter 3 scenario (apollo16): short runs, and the full orbit's headline figures.
 
-The short runs use the built-in GRGM660PRIM field (degree ≤ 4) so that they need no data
-file; the runs of degree 10 and above use the shared file and are skipped without it.
+Every run uses the GRAIL field shipped with gmuk (GRGM660PRIM to degree 150), by name or
+by the path of its file.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import gmuk
-from gmuk import cli, scenarios
-from gmuk.errors import DefinitionError, GmukWarning
-from gmuk.gravity import legendre_4pi, moon_low_degree
+from gmuk import cli, gravity, scenarios
+from gmuk.errors import DefinitionError
+from gmuk.gravity import legendre_4pi
 from gmuk.orbits import KeplerOrbit
 from gmuk.scenarios import apollo16
 
-GRAIL_FILE = (
-    Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "gravity"
-) / "GRGM660PRIM_to150.gfc"
-needs_grail = pytest.mark.skipif(
-    not GRAIL_FILE.is_file(), reason=f"GRAIL field file not present at {GRAIL_FILE}"
-)
+GRAIL_FILE = gravity.field_path("GRGM660PRIM")
 
 
-@pytest.fixture(autouse=True)
-def _no_field_env(monkeypatch):
-    """A developer's GMUK_GRAVITY_FIELD must not change what these tests run."""
-    monkeypatch.delenv(apollo16.FIELD_ENV, raising=False)
+def grail(degree=None):
+    return gravity.load("GRGM660PRIM", degree)
 
 
 @pytest.fixture(scope="module")
 def early():
-    """The first ~36 s (4 outputs) at degrees 0 and 4 with both models (built-in field)."""
+    """The first ~36 s (4 outputs) at degrees 0 and 4 with both models."""
     return apollo16.run(orbits=0.005, degrees=(0, 4))
 
 
@@ -58,7 +50,7 @@ def _position_difference(result, key):
 
 
 def test_initial_state_is_the_stated_orbit_with_the_fields_gm():
-    field = moon_low_degree()
+    field = grail()
     g, V, period = apollo16.initial_state("elements", field.mu, field.radius)
     r, v = g[:3, 3], g[:3, :3] @ V[3:]
     orbit, t = KeplerOrbit.from_state(r, v, field.mu)
@@ -77,7 +69,7 @@ def test_initial_state_is_the_stated_orbit_with_the_fields_gm():
 
 
 def test_printed_initial_state_is_an_86_by_127_km_orbit():
-    field = moon_low_degree()
+    field = grail()
     g, V, period = apollo16.initial_state("printed", field.mu, field.radius)
     assert g[:3, 3].tolist() == [1.824e6, 0.0, 0.0]
     assert V.tolist() == [0.0, 0.0, 9.03813e-4, 0.0, -1.64863e3, 0.0]
@@ -101,7 +93,7 @@ def test_correct_model_position_difference_is_half_delta_a_t_squared(early):
     """Δr(t) = ½ Δa t² + O(t³), Δa the field's harmonic acceleration at the start (F = N)."""
     t = early.trajectories["uniform"].t
     r0 = early.trajectories["uniform"].g_NB[0, 0, :3, 3]
-    da = moon_low_degree(4).acceleration(r0, central=False)
+    da = grail(4).acceleration(r0, central=False)
     assert np.linalg.norm(da[1:]) > 0.2 * np.linalg.norm(da)  # a tangential part
     d = _position_difference(early, "correct_deg4")
     assert np.linalg.norm(d[0]) == 0.0
@@ -115,7 +107,7 @@ def test_thesis_model_pushes_radially_outward_with_its_own_magnitude(early):
     (default) Eq. 26c's parentheses restored: P̄ = 4π P̄ / √2 (p = 0), / 2 (p > 0)."""
     t = early.trajectories["uniform"].t
     r0 = early.trajectories["uniform"].g_NB[0, 0, :3, 3]
-    field = moon_low_degree(4)
+    field = grail(4)
     rn = float(np.linalg.norm(r0))
     assert r0[1] == r0[2] == 0.0  # latitude 0, longitude 0 in F at t = 0
     P = legendre_4pi(4, 0.0)
@@ -137,26 +129,29 @@ def test_thesis_model_pushes_radially_outward_with_its_own_magnitude(early):
 
 @pytest.fixture(scope="module")
 def short():
-    with pytest.warns(GmukWarning, match="degrees 10, 50, 150 skipped"):
-        return apollo16.run(orbits=0.05)
+    """The first 6 % of the orbit with the defaults: degrees 2, 10, 50, 150, both models."""
+    return apollo16.run(orbits=0.06)
 
 
-def test_default_without_file_runs_degree_2_with_the_builtin_field_and_says_so(short):
+def test_default_runs_the_thesis_degrees_with_the_shipped_field(short):
     s = short.summary
-    assert s["degrees"] == [2] and s["models"] == ["correct", "thesis"]
-    assert "built-in GRGM660PRIM" in s["field"] and "need a field file" in s["field"]
-    assert s["mu_m3_s2"] == moon_low_degree().mu and s["reference_radius_m"] == 1.738e6
-    assert set(short.trajectories) == {"uniform", "correct_deg2", "thesis_deg2"}
-    for prefix in ("correct_deg2", "thesis_deg2", "thesis_vs_correct_deg2"):
-        assert {k for k in s if k.startswith(prefix + "_")} == {
-            f"{prefix}_max_{q}" for q in _HEADLINES
-        } | {f"{prefix}_final_along_track_difference_m"}
+    assert s["degrees"] == [2, 10, 50, 150] and s["models"] == ["correct", "thesis"]
+    assert s["field"] == "GRGM660PRIM (shipped with gmuk, degree 150)"
+    assert s["mu_m3_s2"] == 4.902799806931690e12 and s["reference_radius_m"] == 1.738e6
+    assert set(short.trajectories) == {"uniform"} | {
+        f"{m}_deg{n}" for m in ("correct", "thesis") for n in (2, 10, 50, 150)
+    }
+    for n in (2, 150):
+        for prefix in (f"correct_deg{n}", f"thesis_deg{n}", f"thesis_vs_correct_deg{n}"):
+            assert {k for k in s if k.startswith(prefix + "_")} == {
+                f"{prefix}_max_{q}" for q in _HEADLINES
+            } | {f"{prefix}_final_along_track_difference_m"}
 
 
 def test_summary_is_json_with_units_in_the_keys(short):
     assert json.loads(json.dumps(short.summary)) == short.summary
     assert short.summary["period_s"] == pytest.approx(7128.7066, abs=1e-3)
-    assert short.summary["duration_s"] == pytest.approx(0.05 * short.summary["period_s"])
+    assert short.summary["duration_s"] == pytest.approx(0.06 * short.summary["period_s"])
 
 
 def test_difference_grows_from_zero_at_degree_2(short):
@@ -173,10 +168,10 @@ def test_thesis_model_keeps_the_orbit_plane_and_falls_behind(short):
     """A radial-only force cannot tilt the orbit; the correct field pulls the spacecraft
     inward at the start (lower, faster: ahead), the thesis's flipped sign outward (behind)."""
     s = short.summary
-    assert s["correct_deg2_max_cross_track_difference_m"] > 0.1  # measured 0.80 m
-    assert s["thesis_deg2_max_cross_track_difference_m"] < 1e-5  # measured 2.2e-7 m
-    assert s["correct_deg2_final_along_track_difference_m"] > 1.0  # measured +6.5 m
-    assert s["thesis_deg2_final_along_track_difference_m"] < -1.0  # measured -5.6 m
+    assert s["correct_deg2_max_cross_track_difference_m"] > 0.1  # measured 1.37 m
+    assert s["thesis_deg2_max_cross_track_difference_m"] < 1e-5  # measured 2.5e-7 m
+    assert s["correct_deg2_final_along_track_difference_m"] > 1.0  # measured +11.3 m
+    assert s["thesis_deg2_final_along_track_difference_m"] < -1.0  # measured -9.7 m
 
 
 def test_figures_and_data_are_written(short, tmp_path):
@@ -192,11 +187,8 @@ def test_figures_and_data_are_written(short, tmp_path):
     )
     assert all(p.is_file() and p.stat().st_size > 10_000 for p in paths)
     data = apollo16.write_data(short, tmp_path)
-    assert {p.name for p in data} == {
-        "uniform.npz",
-        "correct_deg2.npz",
-        "thesis_deg2.npz",
-        "differences.npz",
+    assert {p.name for p in data} == {"uniform.npz", "differences.npz"} | {
+        f"{m}_deg{n}.npz" for m in ("correct", "thesis") for n in (2, 10, 50, 150)
     }
     diffs = np.load(tmp_path / "differences.npz")
     assert diffs["correct_deg2__position_m"].shape == (len(diffs["t_s"]), 3)
@@ -204,35 +196,42 @@ def test_figures_and_data_are_written(short, tmp_path):
     assert np.array_equal(back.g_NB, short.trajectories["thesis_deg2"].g_NB)
 
 
-def test_clear_errors_for_missing_field_and_bad_options(tmp_path):
-    with pytest.raises(DefinitionError, match=r"degree 10 needs a lunar gravity field file"):
-        apollo16.run(orbits=0.01, degrees=(2, 10))
-    with pytest.raises(DefinitionError, match="does not exist"):
-        apollo16.run(orbits=0.01, field_path=tmp_path / "missing.gfc")
+def test_clear_errors_for_bad_fields_and_options(tmp_path):
+    with pytest.raises(DefinitionError, match=r"degree 151 requested but field GRGM660PRIM"):
+        apollo16.run(orbits=0.01, degrees=(2, 151))
+    with pytest.raises(DefinitionError, match="neither a field shipped with gmuk"):
+        apollo16.run(orbits=0.01, field=tmp_path / "missing.gfc")
+    with pytest.raises(DefinitionError, match="neither a field shipped with gmuk"):
+        apollo16.run(orbits=0.01, field="GRGM900C")
+    with pytest.raises(DefinitionError, match=r"EGM2008_to70 \(shipped with gmuk.*not lunar"):
+        apollo16.run(orbits=0.01, field="EGM2008", degrees=(2,))
     with pytest.raises(DefinitionError, match="model must be"):
         apollo16.run(orbits=0.01, degrees=(2,), model="exact")
     with pytest.raises(DefinitionError, match="initial must be"):
         apollo16.run(orbits=0.01, degrees=(2,), initial="guess")
+    with pytest.raises(DefinitionError, match="thesis_normalization must be one of"):
+        apollo16.run(orbits=0.01, degrees=(2,), thesis_normalization="none")
     for bad in ((2, 2), (2.5,), (-1,), ()):
         with pytest.raises(DefinitionError, match="distinct integers"):
             apollo16.run(orbits=0.01, degrees=bad)
+    with pytest.raises(TypeError, match="field_path"):  # the former name is not swallowed
+        apollo16.run(orbits=0.01, field_path=GRAIL_FILE)
 
 
-@needs_grail
-def test_a_field_of_another_body_is_refused():
-    earth = GRAIL_FILE.parent / "EGM2008_to70.gfc"
-    with pytest.raises(DefinitionError, match="not a lunar field"):
-        apollo16.run(orbits=0.01, field_path=earth, degrees=(2,))
+def test_field_by_name_path_or_object_is_the_same_field():
+    by_name = apollo16.load_field("grgm660prim", (2,))
+    by_path = apollo16.load_field(GRAIL_FILE, (2,))
+    by_object = apollo16.load_field(grail(10), (2, 10))
+    assert by_name[0] is grail()  # read once per process
+    assert by_path[2] == f"GRGM660PRIM (from {GRAIL_FILE}, degree 150)"
+    assert np.array_equal(by_path[0].C, by_name[0].C) and by_path[0].mu == by_name[0].mu
+    assert by_object[2] == "GRGM660PRIM (given as a field, degree 10)"
+    with pytest.raises(DefinitionError, match="stops at 10"):
+        apollo16.load_field(grail(10), (50,))
 
 
-def test_environment_variable_names_the_field(monkeypatch, tmp_path):
-    monkeypatch.setenv(apollo16.FIELD_ENV, str(tmp_path / "nowhere.gfc"))
-    with pytest.raises(DefinitionError, match=apollo16.FIELD_ENV):
-        apollo16.run(orbits=0.01)
-
-
-def test_cli_list_and_run_without_a_file(tmp_path, capsys):
-    assert scenarios.load("apollo16") is apollo16
+def test_cli_list_run_and_errors(tmp_path, capsys):
+    assert scenarios.get("apollo16") is apollo16.SCENARIO
     assert cli.main(["list"]) == 0
     assert f"apollo16 {apollo16.DESCRIPTION}" in capsys.readouterr().out
     out = tmp_path / "a16"
@@ -240,35 +239,41 @@ def test_cli_list_and_run_without_a_file(tmp_path, capsys):
     assert cli.main([*args, "--degrees", "2", "--model", "correct"]) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenario"] == "apollo16" and summary["models"] == ["correct"]
+    assert summary["options"]["field"] == "GRGM660PRIM" and summary["options"]["degrees"] == [2]
     assert (out / "runs" / "correct_deg2.npz").is_file() and (out / "differences.npz").is_file()
     assert gmuk.load_trajectory(out / "trajectory.npz").body_names == ("spacecraft",)
     capsys.readouterr()
-    assert cli.main([*args, "--degrees", "10"]) == 2
-    err = capsys.readouterr().err
-    assert "--field PATH" in err and apollo16.FIELD_ENV in err
+    assert cli.main([*args, "--degrees", "151"]) == 2
+    assert "degree 151 requested but field GRGM660PRIM" in capsys.readouterr().err
+    assert cli.main([*args, "--field", str(tmp_path / "no.gfc")]) == 2
+    assert "neither a field shipped with gmuk (GRGM660PRIM, EGM2008)" in capsys.readouterr().err
     assert cli.main(["run", "fcei", "--field", "x.gfc"]) == 2
-    assert "does not take --field" in capsys.readouterr().err
+    assert "'fcei' does not take --field x.gfc" in capsys.readouterr().err
     assert cli.main([*args, "--degrees", "two"]) == 2
+    assert "--degrees must be comma-separated integers" in capsys.readouterr().err
+    assert cli.main([*args, "--degrees", "2,2"]) == 2
+    assert "--degrees must be distinct integers ≥ 0" in capsys.readouterr().err
+    assert cli.main([*args, "--model", "exact"]) == 2
+    assert "--model must be one of both, correct, thesis; got 'exact'" in capsys.readouterr().err
 
 
-@needs_grail
-def test_grail_file_degree_10_uses_the_files_gm(tmp_path, capsys):
+def test_field_file_path_on_the_command_line_degree_10(tmp_path):
     out = tmp_path / "a16"
     argv = ["run", "apollo16", "--orbits", "0.02", "--out", str(out), "--no-plots"]
     assert cli.main([*argv, "--field", str(GRAIL_FILE), "--degrees", "2,10"]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["mu_m3_s2"] == 4.902799806931690e12 and "degree 150" in s["field"]
+    assert str(GRAIL_FILE) in s["field"]
     # degree 10 adds to degree 2, but degree 2 carries most of it this early
     d2 = s["correct_deg2_max_position_difference_m"]
     d10 = s["correct_deg10_max_position_difference_m"]
     assert d2 != d10 and 0.5 < d10 / d2 < 1.5
 
 
-@pytest.mark.slow
-@needs_grail
 def test_full_orbit_headline_figures():
-    """One orbit at degrees 2, 10, 50, 150 (measured values in docs/scenarios/chapter3.rst)."""
-    s = apollo16.run(orbits=1.0, field_path=GRAIL_FILE).summary
+    """One orbit at degrees 2, 10, 50, 150, the defaults (``gmuk run apollo16``; measured
+    values in docs/scenarios/chapter3.rst)."""
+    s = apollo16.run().summary
     for n in apollo16.DEGREES:
         # thesis Eqs. 42/59: "almost four kilometers" (largest component 3.8–4.7 km here)
         assert 3.0e3 < s[f"thesis_deg{n}_max_position_component_difference_m"] < 5.0e3

@@ -13,7 +13,7 @@ from gmuk import cli, scenarios
 
 @pytest.fixture(scope="module")
 def fcei_quarter():
-    return scenarios.load("fcei").run(orbits=0.25)
+    return scenarios.get("fcei").run(orbits=0.25)
 
 
 def test_fcei_tracks_the_kepler_orbit_and_lvlh_attitude(fcei_quarter):
@@ -30,7 +30,7 @@ def test_fcei_tracks_the_kepler_orbit_and_lvlh_attitude(fcei_quarter):
 
 
 def test_fccn_constraint_wrench_is_constant():
-    s = scenarios.load("fccn").run(orbits=0.25).summary
+    s = scenarios.get("fccn").run(orbits=0.25).summary
     assert s["constraint_torque_relative_variation"] <= 1e-9
     assert s["nominal_constraint_torque_relative_variation"] <= 1e-9
     # the tiny force is a difference of gravity-sized terms: constant to their round-off
@@ -38,13 +38,13 @@ def test_fccn_constraint_wrench_is_constant():
 
 
 def test_fceim_equals_fcei():
-    s = scenarios.load("fceim").run(orbits=0.25).summary
+    s = scenarios.get("fceim").run(orbits=0.25).summary
     assert s["max_position_difference_vs_fcei_m"] <= 1e-6
     assert s["max_attitude_error_rad"] <= 1e-10
 
 
 def test_ucei_keeps_the_five_constrained_relative_components_and_the_orbit():
-    result = scenarios.load("ucei").run(orbits=0.25)
+    result = scenarios.get("ucei").run(orbits=0.25)
     pair = result.trajectories["ucei"]
     rel = scenarios._lvlh.relative_pose(pair)
     assert np.abs(rel[:, 1:3]).max() <= 1e-9  # rotations about axes 2, 3 (rad)
@@ -56,15 +56,15 @@ def test_ucei_keeps_the_five_constrained_relative_components_and_the_orbit():
 
 
 def test_uceis_rolls_under_the_torque_while_the_orbit_is_unchanged():
-    ucei = scenarios.load("ucei").run(orbits=0.25).summary
-    uceis = scenarios.load("uceis").run(orbits=0.25).summary
+    ucei = scenarios.get("ucei").run(orbits=0.25).summary
+    uceis = scenarios.get("uceis").run(orbits=0.25).summary
     assert uceis["max_abs_roll_rad"] > 2 * ucei["max_abs_roll_rad"]
     assert uceis["max_position_difference_vs_fcei_m"] <= 1e-6
     assert uceis["max_velocity_difference_vs_fcei_m_s"] <= 1e-9
 
 
 def test_uceim_pair_on_t2se3_agrees_with_ucei_and_eq80_is_not_reachable():
-    s = scenarios.load("uceim").run(orbits=0.25).summary
+    s = scenarios.get("uceim").run(orbits=0.25).summary
     assert s["max_position_difference_vs_ucei_m"] <= 1e-6
     assert s["max_roll_difference_vs_ucei_rad"] <= 1e-9
     assert s["max_locked_rotation_rad"] <= 1e-9
@@ -95,7 +95,7 @@ def test_cli_reports_bad_input_clearly(capsys):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["fccn", "fcei", "fceim", "ucei", "uceis", "uceim"])
 def test_full_orbit_scenarios(name):
-    s = scenarios.load(name).run(orbits=1.0).summary
+    s = scenarios.get(name).run(orbits=1.0).summary
     if name in ("fccn", "fcei", "fceim"):
         assert s["max_position_error_m"] <= 1e-6 and s["max_attitude_error_rad"] <= 1e-10
     elif name == "uceim":
