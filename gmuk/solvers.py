@@ -1,6 +1,6 @@
 """Udwadia–Kalaba solve strategies, chosen once when a System is built.
 
-A :class:`UKSolver` turns a state's loads into :class:`gmuk.system.Accelerations`: the free
+A :class:`UKSolver` turns a state's loads into :class:`gmuk.Accelerations`: the free
 acceleration ν̇_a = M⁻¹(ad*_V 𝕀V + Q), the constraint acceleration ν̇_c that the
 Udwadia–Kalaba equation gives for the stacked rows ``A ν̇ = b`` (McCann 2020, Eqs. 2, 64) or
 for ``A g̈ B = C`` on T²SE(3) (Eq. 80), the multipliers and the diagnostics. The System
@@ -32,6 +32,7 @@ from __future__ import annotations
 import abc
 import enum
 import warnings
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
@@ -41,7 +42,8 @@ import scipy.sparse as sp
 from gmuk import _uk_kernels, uk
 from gmuk._numba import entry
 from gmuk._validation import FloatArray, all_finite
-from gmuk.bodies import RigidBody
+from gmuk.bodies import Body, RigidBody
+from gmuk.constraints.tangent_bundle import TangentBundleConstraint
 from gmuk.errors import (
     ConstraintError,
     DefinitionError,
@@ -49,15 +51,17 @@ from gmuk.errors import (
     InconsistentConstraintsWarning,
 )
 from gmuk.lie import se3
+from gmuk.state import Layout
 
 if TYPE_CHECKING:
     from gmuk.state import State
-    from gmuk.system import Accelerations, System
+    from gmuk.system import System
 
 __all__ = [
     "QR_COND_LIMIT",
     "QR_MAX_ROWS",
     "SOLVERS",
+    "Accelerations",
     "DenseSolver",
     "FusedRigidSolver",
     "SolveStatus",
@@ -74,6 +78,67 @@ _EPS = float(np.finfo(float).eps)
 _F64 = np.dtype(np.float64)
 _empty = np.empty
 _uk_rigid_c = entry(_uk_kernels.uk_rigid_c)
+
+
+@dataclass(frozen=True, eq=False)
+class Accelerations:
+    """Accelerations and diagnostics at one state (vectors in System body order, length n_dof).
+
+    Attributes
+    ----------
+    free : ndarray (n_dof,)
+        ν̇_a: the unconstrained acceleration under the *modeled* forces
+        (V̇_a = 𝕀⁻¹(ad*_V 𝕀V + τ) for rigid bodies, Eq. 10b).
+    constraint : ndarray (n_dof,)
+        ν̇_c: the Udwadia–Kalaba constraint acceleration (Eq. 64 / Eq. 2).
+    extra : ndarray (n_dof,)
+        Acceleration from unmodeled forces and controllers (the UK solve does not see it).
+    total : ndarray (n_dof,)
+        ν̇ = free + constraint + extra.
+    constraint_force : ndarray (n_dof,)
+        M ν̇_c = Aᵀλ: the constraint wrench [L; f] of each rigid body in its body frame (the
+        thesis's "control"), the force of each point mass in N.
+    control_force, unmodeled_force : ndarray (n_dof,)
+        Controller wrenches u and unmodeled wrenches, same layout.
+    multipliers : ndarray (s,)
+        λ of Eq. 3, with constraint force Aᵀλ (Pinocchio's ``lambda_c``; −μ of the KKT form).
+    residual : float
+        ‖A(ν̇_a + ν̇_c) − b‖₂ (T²SE(3): relative ‖A g̈ B − C‖_F).
+    rank : int or None
+        Rank of A (None if not computed: sparse path with redundant rows, or T²SE(3)).
+    unreachable : float
+        T²SE(3) only: relative size of the part of Eq. 80's g̈_c outside g·se(3) (0 on R⁶).
+    z_dot : ndarray (n_control,)
+        Rates of the controllers' internal states.
+    """
+
+    layout: Layout
+    free: FloatArray
+    constraint: FloatArray
+    extra: FloatArray
+    total: FloatArray
+    constraint_force: FloatArray
+    control_force: FloatArray
+    unmodeled_force: FloatArray
+    multipliers: FloatArray
+    residual: float
+    rank: int | None
+    unreachable: float
+    z_dot: FloatArray
+
+    @classmethod
+    def _from_dict(cls, fields: dict[str, Any]) -> Accelerations:
+        # The frozen dataclass's __init__ sets 13 fields through object.__setattr__, a
+        # noticeable share of a one-body call; the System passes every field, by name.
+        obj = object.__new__(cls)
+        object.__setattr__(obj, "__dict__", fields)
+        return obj
+
+    def of(self, body: Body | str, field: str = "total") -> FloatArray:
+        """The slice of a per-dof field (e.g. "total", "constraint_force") for one body."""
+        s = self.layout.slot(body)
+        return getattr(self, field)[s.offset : s.offset + s.dof]
+
 
 #: Every registered strategy by name (subclasses with a ``name`` add themselves).
 SOLVERS: dict[str, type[UKSolver]] = {}
@@ -150,8 +215,6 @@ class UKSolver(abc.ABC):
         z_dot: FloatArray,
         rows: Any,
     ) -> Accelerations:
-        from gmuk.system import Accelerations
-
         system = self.system
         a = system._free(state, modeled)
         if system._plant_only_loads:
@@ -305,8 +368,6 @@ class FusedRigidSolver(DenseSolver):
         z_dot: FloatArray,
     ) -> Accelerations:
         """The compiled path, or the dense one for rows it cannot certify."""
-        from gmuk.system import Accelerations
-
         rows = A, b = self.system._stack_rows(state, check_finite=False)
         s = b.size
         if 0 < s <= QR_MAX_ROWS:
@@ -403,8 +464,6 @@ class TangentBundleEq80Solver(UKSolver):
     @classmethod
     def problems(cls, system: System) -> list[str]:
         """Exactly one constraint, with ``tangent_rows`` (a TangentBundleConstraint)."""
-        from gmuk.constraints.tangent_bundle import TangentBundleConstraint
-
         cs = system.constraints
         if len(cs) == 1 and isinstance(cs[0], TangentBundleConstraint):
             return []

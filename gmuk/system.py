@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -30,7 +29,7 @@ from gmuk.control.base import Controller
 from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
 from gmuk.integrate import simulate as _simulate
-from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS, UKSolver
+from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
 from gmuk.state import Layout, State
 
 if TYPE_CHECKING:
@@ -40,66 +39,6 @@ __all__ = ["QR_COND_LIMIT", "QR_MAX_ROWS", "SPARSE_THRESHOLD", "Accelerations", 
 
 #: Above this many degrees of freedom, ``sparse="auto"`` selects the sparse solve.
 SPARSE_THRESHOLD = 300
-
-
-@dataclass(frozen=True, eq=False)
-class Accelerations:
-    """Accelerations and diagnostics at one state (vectors in System body order, length n_dof).
-
-    Attributes
-    ----------
-    free : ndarray (n_dof,)
-        ν̇_a: the unconstrained acceleration under the *modeled* forces
-        (V̇_a = 𝕀⁻¹(ad*_V 𝕀V + τ) for rigid bodies, Eq. 10b).
-    constraint : ndarray (n_dof,)
-        ν̇_c: the Udwadia–Kalaba constraint acceleration (Eq. 64 / Eq. 2).
-    extra : ndarray (n_dof,)
-        Acceleration from unmodeled forces and controllers (the UK solve does not see it).
-    total : ndarray (n_dof,)
-        ν̇ = free + constraint + extra.
-    constraint_force : ndarray (n_dof,)
-        M ν̇_c = Aᵀλ: the constraint wrench [L; f] of each rigid body in its body frame (the
-        thesis's "control"), the force of each point mass in N.
-    control_force, unmodeled_force : ndarray (n_dof,)
-        Controller wrenches u and unmodeled wrenches, same layout.
-    multipliers : ndarray (s,)
-        λ of Eq. 3, with constraint force Aᵀλ (Pinocchio's ``lambda_c``; −μ of the KKT form).
-    residual : float
-        ‖A(ν̇_a + ν̇_c) − b‖₂ (T²SE(3): relative ‖A g̈ B − C‖_F).
-    rank : int or None
-        Rank of A (None if not computed: sparse path with redundant rows, or T²SE(3)).
-    unreachable : float
-        T²SE(3) only: relative size of the part of Eq. 80's g̈_c outside g·se(3) (0 on R⁶).
-    z_dot : ndarray (n_control,)
-        Rates of the controllers' internal states.
-    """
-
-    layout: Layout
-    free: FloatArray
-    constraint: FloatArray
-    extra: FloatArray
-    total: FloatArray
-    constraint_force: FloatArray
-    control_force: FloatArray
-    unmodeled_force: FloatArray
-    multipliers: FloatArray
-    residual: float
-    rank: int | None
-    unreachable: float
-    z_dot: FloatArray
-
-    @classmethod
-    def _from_dict(cls, fields: dict[str, Any]) -> Accelerations:
-        # The frozen dataclass's __init__ sets 13 fields through object.__setattr__, a
-        # noticeable share of a one-body call; the System passes every field, by name.
-        obj = object.__new__(cls)
-        object.__setattr__(obj, "__dict__", fields)
-        return obj
-
-    def of(self, body: Body | str, field: str = "total") -> FloatArray:
-        """The slice of a per-dof field (e.g. "total", "constraint_force") for one body."""
-        s = self.layout.slot(body)
-        return getattr(self, field)[s.offset : s.offset + s.dof]
 
 
 class System:
