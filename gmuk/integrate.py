@@ -10,19 +10,23 @@ states. The step ends with ``G₁ = G₀ exp(ξ₁^)``, so poses stay on SE(3) b
 one Newton–Schulz iteration ``R ← R (3I − RᵀR)/2`` per step removes round-off drift, keeping
 ‖RᵀR − I‖ at the 1e-16 level over any number of steps.
 
-Methods
--------
-``"DOP853"`` (default)
-    Dormand–Prince 8(5,3) with error control and a 7th-order continuous extension for
-    output times (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.10; coefficients
-    from ``scipy.integrate._ivp.dop853_coefficients``). A step with output times inside it
-    is accepted only if the continuous extension also meets the tolerance, estimated from
-    its defect (one more evaluation per such step): RKMK's step ends are often far more
-    accurate than the extension between them, which the step-end estimate cannot see.
-``"DOPRI5"``
-    Dormand–Prince 5(4) (Dormand & Prince 1980), stepping exactly onto output times.
-``"RK4"``
-    Classical fixed-step Runge–Kutta of order 4 (``step`` required).
+The Runge–Kutta method is an object (:mod:`gmuk.integrators`):
+:class:`~gmuk.integrators.DOP853` (default; Dormand–Prince 8(5,3), adaptive, with a continuous
+extension of order 7 for output times whose error is controlled too),
+:class:`~gmuk.integrators.DOPRI5` (Dormand–Prince 5(4), adaptive, stepping exactly onto output
+times) and :class:`~gmuk.integrators.RK4` (classical, fixed step). :func:`simulate` accepts a
+registered name (case-insensitive), a :class:`~gmuk.integrators.RungeKuttaMethod` subclass or
+an instance; a subclass with a ``name`` registers itself.
+
+Error weights follow one rule for the whole state: every 3-vector is weighed by its
+Euclidean norm, every scalar by its absolute value, each taking the larger of its values at
+both ends of the step, ``w = atol + rtol · max(‖u(t₀)‖, ‖u(t₁)‖)`` on each component of u.
+The 3-vectors are a rigid body's ω and v (twist, body frame), a point mass's position r_N and
+velocity v_N, and the two halves of ξ: its rotation part is weighed against 1 rad
+(``w = atol + rtol``) and its translation part against the distance ‖r‖ of the step's base
+pose. Slack coordinates and controller states are scalars. No weight depends on how the
+inertial or body axes are chosen. The step error is the RMS of (error / w) over all entries
+(DOP853: Hairer's combination of its order-5 and order-3 estimates in that norm).
 
 References
 ----------
@@ -34,13 +38,22 @@ from __future__ import annotations
 import sys
 import time
 import warnings
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from gmuk._validation import FloatArray
 from gmuk.errors import DefinitionError, GmukError, GmukWarning, SimulationError
+
+# The method classes and the registry, re-exported here for convenience.
+from gmuk.integrators import DOP853 as DOP853
+from gmuk.integrators import DOPRI5 as DOPRI5
+from gmuk.integrators import METHODS as METHODS
+from gmuk.integrators import RK4 as RK4
+from gmuk.integrators import RungeKuttaMethod as RungeKuttaMethod
+from gmuk.integrators import get_method as get_method
+from gmuk.integrators import method_names as method_names
+from gmuk.integrators._base import label
 from gmuk.lie import _kernels
 from gmuk.state import State
 from gmuk.trajectory import Trajectory
@@ -51,52 +64,11 @@ if TYPE_CHECKING:
 __all__ = ["METHODS", "simulate"]
 
 
-@dataclass(frozen=True)
-class _Tableau:
-    A: FloatArray
-    b: FloatArray
-    c: FloatArray
-    order: int
-    e: FloatArray | None = None  # b − b̂ for the embedded estimate (incl. FSAL stage)
-    fsal: bool = False
-
-
-def _dopri5() -> _Tableau:
-    # Dormand & Prince (1980), J. Comput. Appl. Math. 6, 19–26, Table 2 (RK5(4)7M).
-    A = np.zeros((7, 7))
-    A[1, :1] = [1 / 5]
-    A[2, :2] = [3 / 40, 9 / 40]
-    A[3, :3] = [44 / 45, -56 / 15, 32 / 9]
-    A[4, :4] = [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729]
-    A[5, :5] = [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656]
-    A[6, :6] = [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84]
-    b = A[6].copy()  # the 7th stage is f(t + h, y₁): first same as last
-    b_hat = np.array(
-        [5179 / 57600, 0, 7571 / 16695, 393 / 640, -92097 / 339200, 187 / 2100, 1 / 40]
-    )
-    c = np.array([0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1])
-    return _Tableau(A[:6, :6], b[:6], c, 5, b - b_hat, fsal=True)
-
-
-def _rk4() -> _Tableau:
-    A = np.zeros((4, 4))
-    A[1, 0] = A[2, 1] = 0.5
-    A[3, 2] = 1.0
-    return _Tableau(A, np.array([1, 2, 2, 1]) / 6, np.array([0, 0.5, 0.5, 1]), 4)
-
-
-def _dop853() -> tuple[_Tableau, Any]:
-    from scipy.integrate._ivp import dop853_coefficients as d
-
-    n = d.N_STAGES
-    return _Tableau(d.A[:n, :n], d.B, d.C[:n], 8, None, fsal=True), d
-
-
-METHODS = ("DOP853", "DOPRI5", "RK4")
-
-
 class _Problem:
-    """The RKMK vector field on Y = [ξ (6 n_r), V (6 n_r), x, ẋ, z] about base poses G₀."""
+    """The RKMK vector field on Y = [ξ (6 n_r), V (6 n_r), x, ẋ, z] about base poses G₀.
+
+    ``G0`` holds the current step's base poses; the stepper sets it before each step.
+    """
 
     def __init__(self, system: System) -> None:
         self.system = system
@@ -111,6 +83,15 @@ class _Problem:
         self.s_z = slice(2 * nr6 + 2 * self.ne, 2 * nr6 + 2 * self.ne + self.nc)
         self.size = 2 * nr6 + 2 * self.ne + self.nc
         self.rigid_idx = (lay.rigid_offsets[:, None] + np.arange(6)).reshape(-1, 6)
+        # Entries of Y holding point masses' positions and velocities, one row per 3-vector
+        # (positions first), for the error weights; None without point masses.
+        pts = [sl.index for sl in map(lay.slot, lay.names) if sl.kind == "point"]
+        self.point_idx: np.ndarray | None = None
+        if pts:
+            cols = np.array(pts, dtype=np.intp)[:, None] + np.arange(3)
+            self.point_idx = np.concatenate([self.s_x.start + cols, self.s_xd.start + cols])
+        self.G0 = np.zeros((self.nr, 4, 4))
+        self.acc: Accelerations | None = None
         self.n_rhs = 0
 
     def pack(self, state: State) -> FloatArray:
@@ -147,24 +128,26 @@ class _Problem:
         dY[self.s_z] = acc.z_dot
         return dY
 
-    def __call__(self, t: float, Y: FloatArray, G0: FloatArray) -> tuple[FloatArray, Accelerations]:
+    def rhs(self, t: float, Y: FloatArray) -> FloatArray:
+        """dY/dt at (t, Y) about ``G0``: the method's ``f``. The System's accelerations of
+        the latest call are kept in ``acc`` (the step end records them)."""
         self.n_rhs += 1
-        acc = self.system.accelerations(self.state(t, Y, G0))
+        self.acc = acc = self.system.accelerations(self.state(t, Y, self.G0))
         dY = self.deriv(Y, acc)
         if not np.isfinite(dY).all():
             raise FloatingPointError(f"non-finite derivative at t = {t:.9g} s")
-        return dY, acc
+        return dY
 
     def scale(
         self, Y0: FloatArray, Y1: FloatArray, G0: FloatArray, rtol: float, atol: float
     ) -> FloatArray:
         """Error weights, one per entry of Y (the larger of the values at both ends).
 
-        Rigid bodies are weighted by 3-vector norms, so that the weights do not depend on
-        how the inertial or body axes are chosen: ξ's rotation part against 1 rad, its
-        translation part (body-frame components) against the distance ‖r‖ of the base pose,
-        the twist's ω against ‖ω‖ and its v against ‖v‖. Euclidean coordinates and
-        controller states are weighted component by component.
+        Every 3-vector is weighed by its norm, so that no weight depends on how the
+        inertial or body axes are chosen: ξ's rotation part against 1 rad, its translation
+        part (body-frame components) against the distance ‖r‖ of the base pose, the twist's
+        ω and v and a point mass's position and velocity by their norms. Scalars (slack
+        coordinates, controller states) by their absolute values.
         """
         sc = atol + rtol * np.maximum(np.abs(Y0), np.abs(Y1))
         if self.nr:
@@ -178,6 +161,10 @@ class _Problem:
                 np.linalg.norm(Y1[self.s_V].reshape(-1, 2, 3), axis=2),
             )
             sc[self.s_V] = np.repeat(atol + rtol * V, 3)
+        idx = self.point_idx
+        if idx is not None:
+            n = np.maximum(np.linalg.norm(Y0[idx], axis=1), np.linalg.norm(Y1[idx], axis=1))
+            sc[idx] = (atol + rtol * n)[:, None]
         return sc
 
     def advance_base(self, Y: FloatArray, G0: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -272,7 +259,7 @@ def simulate(
     t_span: tuple[float, float],
     *,
     t_eval: Any = None,
-    method: str = "DOP853",
+    method: str | type[RungeKuttaMethod] | RungeKuttaMethod = "DOP853",
     rtol: float = 1e-10,
     atol: float = 1e-10,
     step: float | None = None,
@@ -293,14 +280,23 @@ def simulate(
         Start and end times (s), end > start.
     t_eval : array_like, optional
         Output times within t_span (increasing). Default: every accepted step.
-    method : {"DOP853", "DOPRI5", "RK4"}
+    method : str, RungeKuttaMethod subclass or instance
+        The Runge–Kutta method (:mod:`gmuk.integrators`): a registered name,
+        case-insensitive — ``"DOP853"`` (default), ``"DOPRI5"``, ``"RK4"`` or any name a
+        user subclass registered (see :data:`METHODS`) — or a class or an instance.
     rtol, atol : float
-        Relative and absolute tolerances (adaptive methods). Error weights use the distance
-        ``‖r‖`` (m) for the translational part of ξ, 1 rad for its rotational part and the
-        norms ``‖ω‖``, ``‖v‖`` for the twist, so they do not depend on the choice of axes.
-        With DOP853 and ``t_eval``, they bound the error of the interpolated outputs too.
+        Relative and absolute tolerances (adaptive methods), applied with one rule: each
+        3-vector u of the state is weighed by its norm, each scalar by its absolute value,
+        ``w = atol + rtol · max(‖u(t₀)‖, ‖u(t₁)‖)`` over the step. The 3-vectors are the
+        twist's ω (rad/s) and v (m/s), a point mass's position (m) and velocity (m/s), and
+        the step's exponential coordinates ξ, whose rotation part is weighed against 1 rad
+        and translation part against the distance ‖r‖ (m) of the step's base pose. Slack
+        coordinates and controller states are scalars. No weight depends on the choice of
+        axes. With a method that has a continuous extension (DOP853) and ``t_eval``, the
+        tolerances bound the error of the interpolated outputs too.
     step : float
-        Step size (s) for RK4 (required there); ignored otherwise.
+        Step size (s) for a fixed-step method such as RK4 (required there); ignored by the
+        adaptive ones.
     first_step, max_step : float, optional
         Step-size bounds (s) for the adaptive methods.
     max_steps : int
@@ -318,9 +314,14 @@ def simulate(
     Returns
     -------
     Trajectory
+        ``stats["method"]`` holds the method's name.
+
+    Raises
+    ------
+    DefinitionError
+        For an unknown method name (the message lists the registered ones) or bad arguments.
     """
-    if method not in METHODS:
-        raise DefinitionError(f"method must be one of {METHODS}; got {method!r}")
+    m = get_method(method)
     if on_failure not in ("raise", "return"):
         raise DefinitionError(f"on_failure must be 'raise' or 'return'; got {on_failure!r}")
     t0, t1 = (float(v) for v in t_span)
@@ -337,14 +338,16 @@ def simulate(
         or not np.isfinite(outs).all()
     ):
         raise DefinitionError(f"t_eval must be strictly increasing within t_span {t_span}")
-    if method == "RK4" and not (step is not None and step > 0):
-        raise DefinitionError("method 'RK4' needs a positive fixed step (step=...)")
+    if not m.adaptive and not (step is not None and step > 0):
+        raise DefinitionError(
+            f"method {label(m)!r} has a fixed step and needs a positive step (step=...)"
+        )
     if not (rtol > 0 and atol > 0):
         raise DefinitionError(f"rtol and atol must be > 0; got {rtol}, {atol}")
 
     prob = _Problem(system)
     rec = _Recorder(prob)
-    stepper = _Stepper(prob, method, rtol, atol, step, first_step, max_step)
+    stepper = _Stepper(prob, m, rtol, atol, step, first_step, max_step)
     bar = _Progress(progress, t0, t1)
     status, message = "success", ""
     try:
@@ -364,46 +367,18 @@ def simulate(
     return rec.build(status, message, stepper.stats())
 
 
-#: Where the continuous extension's defect is sampled, and the factor taking its norm to a
-#: bound on the extension's error (see ``_Stepper._dense_error``).
-_DEFECT_NODE, _DEFECT_GAIN = 0.95, 0.18
-
-
-class _Interpolant:
-    """u(s) = Y₀ + s(F₀ + (1−s)(F₁ + s(F₂ + …))), s = (t − t₀)/h: DOP853's dense output."""
-
-    def __init__(self, t: float, h: float, Y0: FloatArray, F: FloatArray) -> None:
-        self.t, self.h, self.Y0, self.F = t, h, Y0, F
-
-    def __call__(self, tt: float) -> FloatArray:
-        s = (tt - self.t) / self.h
-        out = np.zeros(self.Y0.size)
-        for i, Fi in enumerate(self.F[::-1]):
-            out = (out + Fi) * (s if i % 2 == 0 else 1.0 - s)
-        return self.Y0 + out
-
-    def value_and_derivative(self, s: float) -> tuple[FloatArray, FloatArray]:
-        """u(s) and du/ds."""
-        out = np.zeros(self.Y0.size)
-        dout = np.zeros(self.Y0.size)
-        for i, Fi in enumerate(self.F[::-1]):
-            q = out + Fi
-            if i % 2 == 0:
-                out, dout = q * s, dout * s + q
-            else:
-                out, dout = q * (1.0 - s), dout * (1.0 - s) - q
-        return self.Y0 + out, dout
-
-
 class _StepFailure(RuntimeError):
     """Step-size underflow or too many steps."""
 
 
 class _Stepper:
+    """The RKMK step loop: step-size control, output times, base-pose updates. Everything
+    that depends on the Runge–Kutta method is asked of the method object."""
+
     def __init__(
         self,
         prob: _Problem,
-        method: str,
+        method: RungeKuttaMethod,
         rtol: float,
         atol: float,
         step: float | None,
@@ -416,13 +391,6 @@ class _Stepper:
         self.fixed = step
         self.first_step = first_step
         self.max_step = max_step
-        self.dop853: Any = None
-        if method == "DOP853":
-            self.tab, self.dop853 = _dop853()
-        elif method == "DOPRI5":
-            self.tab = _dopri5()
-        else:
-            self.tab = _rk4()
         self.t = 0.0
         self.n_steps = self.n_rejected = 0
 
@@ -431,103 +399,26 @@ class _Stepper:
             "n_rhs": self.p.n_rhs,
             "n_steps": self.n_steps,
             "n_rejected": self.n_rejected,
-            "method": self.method,
+            "method": label(self.method),
             "rtol": self.rtol,
             "atol": self.atol,
         }
 
-    # -- one RK step from (t, Y, G0) with step h; returns Y1, stages K, error norm
-    def _stages(
-        self, t: float, Y: FloatArray, G0: FloatArray, h: float, k1: FloatArray
-    ) -> FloatArray:
-        tab = self.tab
-        s = tab.b.size
-        K = np.empty((s + (1 if tab.fsal else 0), Y.size))
-        K[0] = k1
-        for i in range(1, s):
-            Yi = Y + h * (tab.A[i, :i] @ K[:i])
-            K[i] = self.p(t + tab.c[i] * h, Yi, G0)[0]
-        return K
-
-    def _error(
-        self, Y: FloatArray, Y1: FloatArray, G0: FloatArray, K: FloatArray, h: float
-    ) -> float:
-        sc = self.p.scale(Y, Y1, G0, self.rtol, self.atol)
-        if self.method == "DOP853":
-            d = self.dop853
-            e5 = (K.T @ d.E5) / sc
-            e3 = (K.T @ d.E3) / sc
-            n5, n3 = float(e5 @ e5), float(e3 @ e3)
-            if n5 == 0.0 and n3 == 0.0:
-                return 0.0
-            return abs(h) * n5 / np.sqrt((n5 + 0.01 * n3) * sc.size)
-        assert self.tab.e is not None
-        err = h * (K.T @ self.tab.e) / sc
-        return float(np.sqrt(err @ err / sc.size))
-
-    def _initial_step(
-        self, t: float, Y: FloatArray, G0: FloatArray, f0: FloatArray, t_end: float
-    ) -> float:
+    def _initial_step(self, t: float, Y: FloatArray, f0: FloatArray, t_end: float) -> float:
         if self.first_step is not None:
             return min(self.first_step, t_end - t)
-        sc = self.p.scale(Y, Y, G0, self.rtol, self.atol)
+        sc = self.p.scale(Y, Y, self.p.G0, self.rtol, self.atol)
         d0 = np.sqrt(np.mean((Y / sc) ** 2))
         d1 = np.sqrt(np.mean((f0 / sc) ** 2))
         h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
         h0 = min(h0, t_end - t)
-        f1 = self.p(t + h0, Y + h0 * f0, G0)[0]
+        f1 = self.p.rhs(t + h0, Y + h0 * f0)
         d2 = np.sqrt(np.mean(((f1 - f0) / sc) ** 2)) / h0
         if d1 <= 1e-15 and d2 <= 1e-15:
             h1 = max(1e-6, h0 * 1e-3)
         else:
-            h1 = (0.01 / max(d1, d2)) ** (1.0 / (self.tab.order + 1))
+            h1 = (0.01 / max(d1, d2)) ** (1.0 / (self.method.order + 1))
         return float(min(100 * h0, h1, self.max_step, t_end - t))
-
-    def _dense(
-        self,
-        t: float,
-        Y: FloatArray,
-        G0: FloatArray,
-        h: float,
-        K: FloatArray,
-        Y1: FloatArray,
-        f1: FloatArray,
-    ) -> _Interpolant:
-        """DOP853 continuous extension on [t, t + h] in the local coordinates."""
-        d = self.dop853
-        n = d.N_STAGES
-        Kx = np.empty((d.N_STAGES_EXTENDED, Y.size))
-        Kx[: n + 1] = K[: n + 1]
-        for i in range(n + 1, d.N_STAGES_EXTENDED):
-            Yi = Y + h * (d.A[i, :i] @ Kx[:i])
-            Kx[i] = self.p(t + d.C[i] * h, Yi, G0)[0]
-        dY = Y1 - Y
-        F = np.empty((d.INTERPOLATOR_POWER, Y.size))
-        F[0] = dY
-        F[1] = h * K[0] - dY
-        F[2] = 2.0 * dY - h * (f1 + K[0])
-        F[3:] = h * (d.D @ Kx)
-        return _Interpolant(t, h, Y, F)
-
-    def _dense_error(self, interp: _Interpolant, G0: FloatArray, Y1: FloatArray) -> float:
-        """Estimated maximum error of the continuous extension over the step, in the norm
-        of the step error (≤ 1: within tolerance). One right-hand-side evaluation.
-
-        The extension u(s), s ∈ [0, 1], has order 7: its error is
-        e(s) = h⁸ Σ_τ e_τ(s) F(τ)(y₀) + O(h⁹) over the trees τ of order 8, and its defect
-        δ(s) = h f(u(s)) − u′(s) = e′(s) + O(h e). The defect is sampled at s* = 0.95, near
-        where the e_τ′ peak. For every one of the 115 trees, max|e_τ| / |e_τ′(s*)| lies
-        between 0.112 and 0.179 with DOP853's coefficients, so 0.18 ‖δ(s*)‖ bounds the
-        error of any single elementary differential. (Sampling the defect is the idea of
-        defect control: W. H. Enright, "A new error-control for initial value solvers",
-        Appl. Math. Comput. 31 (1989); here the defect serves as an error estimate.)
-        """
-        s_star = _DEFECT_NODE
-        u, du = interp.value_and_derivative(s_star)
-        f = self.p(interp.t + s_star * interp.h, u, G0)[0]
-        sc = self.p.scale(interp.Y0, Y1, G0, self.rtol, self.atol)
-        dev = (interp.h * f - du) / sc
-        return _DEFECT_GAIN * float(np.sqrt(dev @ dev / sc.size))
 
     def run(
         self,
@@ -538,18 +429,24 @@ class _Stepper:
         max_steps: int,
         bar: _Progress,
     ) -> None:
-        p = self.p
+        p, m = self.p, self.method
+        f = p.rhs
+        b, s, order = m.b, m.n_stages, m.order
+        fsal, adaptive = m.fsal, m.adaptive
+        dense = m.dense_output and outs is not None
+        step_to_outputs = m.steps_onto_outputs and outs is not None
+        rtol, atol = self.rtol, self.atol
         t = self.t = state0.t
-        G0 = state0.g.copy()
+        G0 = p.G0 = state0.g.copy()
         Y = p.pack(state0)
-        f0, acc0 = p(t, Y, G0)
+        f0 = f(t, Y)
+        acc0 = p.acc
+        assert acc0 is not None
         out_i = 0
         if outs is None or outs[0] == t:
             rec.add(state0, acc0)
             out_i = 0 if outs is None else 1
-        adaptive = self.method != "RK4"
-        h = self._initial_step(t, Y, G0, f0, t_end) if adaptive else float(self.fixed or 0)
-        step_to_outputs = self.method != "DOP853" and outs is not None
+        h = self._initial_step(t, Y, f0, t_end) if adaptive else float(self.fixed or 0)
         while t < t_end:
             if self.n_steps >= max_steps:
                 raise _StepFailure(f"reached max_steps = {max_steps}")
@@ -561,14 +458,16 @@ class _Stepper:
             h_try = t_target - t if t_target - t <= h * (1.0 + 1e-6) else h
             if h_try <= 10 * np.finfo(float).eps * max(1.0, abs(t)):
                 raise _StepFailure(f"step size underflow (h = {h_try:.3g} s)")
-            K = self._stages(t, Y, G0, h_try, f0)
-            Y1 = Y + h_try * (self.tab.b @ K[: self.tab.b.size])
-            f1, acc1 = p(t + h_try, Y1, G0)  # reused as the next step's first stage
-            if self.tab.fsal:
+            K = m.stages(f, t, Y, h_try, f0)
+            Y1 = Y + h_try * (b @ K[:s])
+            f1 = f(t + h_try, Y1)  # reused as the next step's first stage
+            acc1 = p.acc
+            if fsal:
                 K[-1] = f1
             if adaptive:
-                err = self._error(Y, Y1, G0, K, h_try)
-                factor = 0.9 * (max(err, 1e-10) ** (-1.0 / self.tab.order))
+                sc = p.scale(Y, Y1, G0, rtol, atol)
+                err = m.error_norm(K, h_try, sc)
+                factor = 0.9 * (max(err, 1e-10) ** (-1.0 / order))
                 if err > 1.0:
                     self.n_rejected += 1
                     h = h_try * max(0.2, min(0.9, factor))
@@ -577,31 +476,34 @@ class _Stepper:
             else:
                 h_next = h
             t_new = t + h_try
-            if outs is not None and self.method == "DOP853":
+            if dense and outs is not None:
                 hit = outs[out_i:][outs[out_i:] < t_new]
                 if hit.size:
-                    # Output times inside the step: the continuous extension must meet the
-                    # tolerance as well, or the step is retried shorter.
-                    interp = self._dense(t, Y, G0, h_try, K, Y1, f1)
-                    err_d = self._dense_error(interp, G0, Y1)
-                    factor_d = 0.9 * (max(err_d, 1e-10) ** (-1.0 / self.tab.order))
-                    if err_d > 1.0:
-                        self.n_rejected += 1
-                        h = h_try * max(0.2, min(0.9, factor_d))
-                        continue
-                    h_next = min(h_next, h_try * min(10.0, max(0.2, factor_d)))
+                    interp = m.interpolant(f, t, Y, h_try, K, Y1)
+                    if adaptive:
+                        # Output times inside the step: the continuous extension must meet
+                        # the tolerance as well, or the step is retried shorter.
+                        err_d = m.interpolant_error(f, interp, sc)
+                        factor_d = 0.9 * (max(err_d, 1e-10) ** (-1.0 / order))
+                        if err_d > 1.0:
+                            self.n_rejected += 1
+                            h = h_try * max(0.2, min(0.9, factor_d))
+                            continue
+                        h_next = min(h_next, h_try * min(10.0, max(0.2, factor_d)))
                     for tt in hit:
                         st = p.state(float(tt), interp(float(tt)), G0)
                         rec.add(st)
                         out_i += 1
             G1, Y1r = p.advance_base(Y1, G0)
             state1 = p.state(t_new, Y1r, G1)
+            assert acc1 is not None
             f0 = p.deriv(Y1r, acc1)  # same accelerations; ξ̇ = V at the new base (ξ = 0)
             if outs is None or (out_i < outs.size and outs[out_i] == t_new):
                 rec.add(state1, acc1)
                 if outs is not None:
                     out_i += 1
             t, Y, G0, h = t_new, Y1r, G1, h_next
+            p.G0 = G0
             self.t = t
             self.n_steps += 1
             bar.update(t)

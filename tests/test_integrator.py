@@ -104,21 +104,23 @@ def test_dense_output_is_seventh_order_within_a_step(s):
 
 
 def test_dense_error_estimate_bounds_the_interpolation_error_within_a_step():
-    # The defect-based estimate (_Stepper._dense_error) against the true error of the
+    # The defect-based estimate (DOP853.interpolant_error) against the true error of the
     # continuous extension over one step, both in the step-error norm: conservative, and by
     # less than a factor 3 (measured 1.55 here and 1.2-1.6 along an elliptic orbit).
     from gmuk import integrate
 
     system, state = free_body((0.9, 2.0, 0.4, 1.0, -0.5, 0.3))
     prob = integrate._Problem(system)
-    stepper = integrate._Stepper(prob, "DOP853", 1e-10, 1e-10, None, None, np.inf)
-    h, G0, Y = 0.2, state.g.copy(), prob.pack(state)
-    K = stepper._stages(0.0, Y, G0, h, prob(0.0, Y, G0)[0])
-    Y1 = Y + h * (stepper.tab.b @ K[:12])
-    K[-1] = f1 = prob(h, Y1, G0)[0]
-    interp = stepper._dense(0.0, Y, G0, h, K, Y1, f1)
-    estimate = stepper._dense_error(interp, G0, Y1)
+    method = integrate.DOP853()
+    h, Y = 0.2, prob.pack(state)
+    G0 = prob.G0 = state.g.copy()
+    f = prob.rhs
+    K = method.stages(f, 0.0, Y, h, f(0.0, Y))
+    Y1 = Y + h * (method.b @ K[: method.n_stages])
+    K[-1] = f(h, Y1)
+    interp = method.interpolant(f, 0.0, Y, h, K, Y1)
     sc = prob.scale(Y, Y1, G0, 1e-10, 1e-10)
+    estimate = method.interpolant_error(f, interp, sc)
     true = 0.0
     for s in np.linspace(0.05, 0.95, 19):
         ref = system.simulate(
