@@ -26,6 +26,12 @@ TWO_PI = 2.0 * math.pi
 EPS = np.finfo(float).eps
 
 
+def same_to_ulps(a: float, b: float, ulps: int = 2) -> bool:
+    """a and b equal to within ``ulps`` units in the last place of the larger."""
+    b = float(b)
+    return abs(a - b) <= ulps * math.ulp(max(abs(a), abs(b)))
+
+
 def _mp_kepler(M: float, e: float, start: float):
     """The root of E − e sin E = M for the exact binary values of M and e, to 45 digits."""
     return mp.findroot(lambda E: E - mp.mpf(e) * mp.sin(E) - mp.mpf(M), mp.mpf(start), tol=1e-90)
@@ -96,8 +102,11 @@ def test_solver_broadcasts_mean_anomaly_against_eccentricity():
     M=st.floats(-50.0, 50.0, allow_nan=False, allow_infinity=False),
     e=st.floats(0.0, 0.999, exclude_max=False),
 )
-def test_scalar_fast_path_equals_the_vectorised_solver_bit_for_bit(M, e):
-    assert kepler.eccentric_from_mean_scalar(M, e) == float(kepler.eccentric_from_mean(M, e))
+def test_scalar_fast_path_equals_the_vectorised_solver_to_the_last_bit_or_two(M, e):
+    # The scalar path calls libm (math.sin), the vectorised one numpy's ufuncs, whose SIMD
+    # kernels (AVX-512 on some CPUs) may round differently by one ulp; the iteration then
+    # ends one ulp apart. On CPUs where both round alike the results are identical.
+    assert same_to_ulps(kepler.eccentric_from_mean_scalar(M, e), kepler.eccentric_from_mean(M, e))
 
 
 @settings(max_examples=300, deadline=None)
@@ -159,7 +168,7 @@ def test_hyperbolic_anomaly_matches_a_50_digit_solution(e):
     for m, x in zip(M[1:], H[1:], strict=True):
         ref = mp.findroot(lambda h, m=m: mp.mpf(e) * mp.sinh(h) - h - mp.mpf(m), mp.mpf(float(x)))
         assert abs(float((ref - mp.mpf(float(x))) / ref)) <= 4 * EPS
-        assert kepler.hyperbolic_from_mean_scalar(float(m), e) == x
+        assert same_to_ulps(kepler.hyperbolic_from_mean_scalar(float(m), e), x)
 
 
 @settings(max_examples=200, deadline=None)
