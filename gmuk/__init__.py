@@ -12,6 +12,7 @@ The flow: parts (bodies, constraints, force models, controllers) → :class:`Sys
 from gmuk import (
     constraints,
     control,
+    crosscheck,
     dynamics,
     errors,
     forces,
@@ -37,6 +38,7 @@ from gmuk.constraints import (
     VirtualPairT2,
 )
 from gmuk.control import Controller
+from gmuk.crosscheck import check
 from gmuk.dynamics import spatial_inertia
 from gmuk.forces import (
     AppliedWrench,
@@ -95,8 +97,10 @@ __all__ = [
     "UniformRotation",
     "VirtualPairT2",
     "__version__",
+    "check",
     "constraints",
     "control",
+    "crosscheck",
     "dynamics",
     "errors",
     "forces",

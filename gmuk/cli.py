@@ -14,8 +14,8 @@ flags after NAME are the common ones above and the options the scenario declares
 options not given take the scenario's defaults. A bad value stops with a message naming the
 flag and what came in, exit status 2.
 
-``gmuk check`` prints :func:`gmuk.check.check`'s table and exits 0 if every quantity agrees
-with Pinocchio within its tolerance, 1 if any does not.
+``gmuk check`` prints the table of :func:`gmuk.check <gmuk.crosscheck.check>` and exits 0 if
+every quantity agrees with Pinocchio within its tolerance, 1 if any does not.
 """
 
 from __future__ import annotations
@@ -152,7 +152,7 @@ def _run(argv: Sequence[str]) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
-    from gmuk.check import check
+    from gmuk.crosscheck import check
 
     report = check(seed=args.seed, n=args.samples, verbose=args.verbose)
     print(report)

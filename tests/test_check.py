@@ -1,4 +1,4 @@
-"""gmuk.check / ``gmuk check``: passes on this install, fails visibly on a perturbed operator."""
+"""gmuk.check() / ``gmuk check``: passes on this install, fails visibly on a perturbed operator."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 
 import gmuk.dynamics
 from gmuk import cli
-from gmuk.check import CheckReport, _swap_op, _swap_vec, check
+from gmuk.crosscheck import CheckReport, _swap_op, _swap_vec, check
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3
 

@@ -2,7 +2,7 @@
 
 gmuk orders twists ``V = [ω; v]``, wrenches ``τ = [L; f]`` and exponential coordinates
 ``ξ = [θ; ρ]`` angular first (McCann 2020, Eq. 9); Pinocchio orders motions and forces
-linear first. The conversions live in :mod:`gmuk.check` (which ``gmuk check`` runs); the
+linear first. The conversions live in :mod:`gmuk.crosscheck` (which ``gmuk check`` runs); the
 cross-check tests take them from here under these names, so that the tests and the
 installed check convert the same way (``docs/conventions.rst``, Ordering).
 
@@ -15,13 +15,13 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from gmuk.check import _SWAP as SWAP
-from gmuk.check import _free_flyer_model
-from gmuk.check import _from_pin_se3 as from_pin_se3
-from gmuk.check import _q_from_g as q_from_g
-from gmuk.check import _swap_op as swap_op
-from gmuk.check import _swap_vec as swap_vec
-from gmuk.check import _to_pin_se3 as to_pin_se3
+from gmuk.crosscheck import _SWAP as SWAP
+from gmuk.crosscheck import _free_flyer_model
+from gmuk.crosscheck import _from_pin_se3 as from_pin_se3
+from gmuk.crosscheck import _q_from_g as q_from_g
+from gmuk.crosscheck import _swap_op as swap_op
+from gmuk.crosscheck import _swap_vec as swap_vec
+from gmuk.crosscheck import _to_pin_se3 as to_pin_se3
 
 __all__ = [
     "SWAP",

@@ -7,8 +7,8 @@ quantity, the worst disagreement against a tolerance; ``gmuk check`` prints that
 exits 1 if any quantity fails. Run it after installing gmuk on a new machine, or after
 changing an operator.
 
->>> from gmuk.check import check
->>> report = check(seed=0, n=20)  # doctest: +SKIP
+>>> import gmuk
+>>> report = gmuk.check(seed=0, n=20)  # doctest: +SKIP
 >>> report.ok  # doctest: +SKIP
 True
 
@@ -463,7 +463,7 @@ def check(seed: int = 0, n: int = 1000, verbose: bool = False) -> CheckReport:
     Notes
     -----
     The quantities, the error measure, the sampled ranges and the tolerances are in the
-    module docstring (:mod:`gmuk.check`). Takes about 0.3 s at the default ``n`` (once
+    module docstring (:mod:`gmuk.crosscheck`). Takes about 0.3 s at the default ``n`` (once
     gmuk's compiled kernels are cached), linear in ``n``.
     """
     for label, value, low in (("n", n, 1), ("seed", seed, 0)):
