@@ -440,7 +440,7 @@ class TangentBundleEq80Solver(UKSolver):
 
     g̈_c = 𝕀̃^{-1/4} (A 𝕀̃^{-1/4})⁺ (C − A g̈_a B) (B 𝕀̃^{-1/4})⁺ 𝕀̃^{-1/4}; each body's diagonal
     block is projected onto g·se(3) and ``Accelerations.unreachable`` reports the relative
-    size of what was discarded (ERRATA). No multipliers (Eq. 80 has none).
+    size of what was discarded (docs/errata.rst). No multipliers (Eq. 80 has none).
     """
 
     name = "eq80"

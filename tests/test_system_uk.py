@@ -31,7 +31,7 @@ def test_uk_accelerations_and_multipliers_equal_kkt_solution(n):
         nu_dot, mu = kkt_solve(system.mass_matrix, acc.free, A, b)
         scale = np.abs(nu_dot).max()
         assert np.abs(acc.total - nu_dot).max() <= 1e-10 * scale
-        # Eq. 3's λ is the negative of the KKT multiplier μ (ERRATA), and Aᵀλ = M ν̇_c.
+        # Eq. 3's λ is the negative of the KKT multiplier μ (docs/errata.rst), and Aᵀλ = M ν̇_c.
         assert np.abs(acc.multipliers + mu).max() <= 1e-10 * np.abs(mu).max()
         assert np.allclose(A.T @ acc.multipliers, acc.constraint_force, rtol=0, atol=1e-10 * scale)
         assert acc.rank == s

@@ -3,7 +3,7 @@
 Differentiating ``g = g_d`` twice with ``ġ = g V^`` gives ``g (V^² + V̇^) = g_d (V_d^² + V̇_d^)``,
 hence ``A = I₆`` and ``b = (g⁻¹ g_d (V_d^² + V̇_d^) − V^²)^∨`` (Eq. 67).
 
-Off the constraint (g ≠ g_d, V ≠ Ad V_d) the matrix inside the vee is not in se(3) (ERRATA,
+Off the constraint (g ≠ g_d, V ≠ Ad V_d) the matrix inside the vee is not in se(3) (docs/errata.rst,
 "Numerically fragile"): gmuk takes the skew part of its rotation block and its translation
 column before the vee. On the constraint both forms agree exactly.
 """
@@ -77,7 +77,8 @@ class ConfigurationTracking(Constraint):
 
     References
     ----------
-    McCann (2020), Eqs. (65)–(67); ERRATA for the projection off the constraint.
+    McCann (2020), Eqs. (65)–(67); the errata page (docs/errata.rst) for the
+    projection off the constraint.
     """
 
     body_kinds = frozenset({BodyKind.RIGID})

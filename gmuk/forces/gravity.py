@@ -10,7 +10,7 @@
   ``L = 3μ/|r|⁵ · r_B × (J r_B)``,
   ``f = −μm/|r|³ · (r_B + 3/(m|r|²) [J + ½(tr J − 5 r̂_Bᵀ J r̂_B) I] r_B)``.
 
-  ERRATA: correct as printed with r_B = Rᵀr (Eqs. 33/52 write inertial r, where J must be
+  Errata (docs/errata.rst): correct as printed with r_B = Rᵀr (Eqs. 33/52 write inertial r, where J must be
   R J Rᵀ); both match point-cloud quadrature to 1e-11.
 """
 
@@ -65,7 +65,7 @@ class PointMassGravity(ForceModel):
         return np.concatenate([np.zeros(3), g_NB[:3, :3].T @ self.force(t, g_NB[:3, 3], V_B, body)])
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
-        """−μ m r_N/|r_N|³ (N)."""
+        """``−μ m r_N/|r_N|³`` (N)."""
         rn = float(np.sqrt(r_N @ r_N))
         return (-self.mu * body.mass / rn**3) * r_N
 
@@ -113,7 +113,7 @@ class GravityGradient(ForceModel):
         return np.concatenate([L, f])
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
-        """The point-mass force −μ m r_N/|r_N|³ on a particle (N)."""
+        """The point-mass force ``−μ m r_N/|r_N|³`` on a particle (N)."""
         return (-self.mu * body.mass / float(np.sqrt(r_N @ r_N)) ** 3) * r_N
 
 

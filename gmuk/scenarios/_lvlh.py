@@ -2,7 +2,7 @@
 
 The spacecraft has the mass properties printed in Section 3.4; the central body is the Moon
 with μ = 4.9048695e12 m³/s² (the value that makes Section 4.3's printed initial condition
-consistent, ERRATA); the force model is the uniform-field gravity gradient (Eq. 23). The
+consistent, docs/errata.rst); the force model is the uniform-field gravity gradient (Eq. 23). The
 initial state is the reference's own at periselene (t = 0), computed from Eqs. 69–71 as
 corrected (it reproduces the printed numbers to all their digits with this μ).
 """
@@ -33,9 +33,10 @@ LM_INERTIA = np.array(
     ]
 )
 MU = MU_MOON_THESIS_CONSISTENT
-#: Integration tolerances for every Chapter 4 scenario: FCEI's position error over one orbit
-#: is 4.3e-8 m at 1554 right-hand-side evaluations (``gmuk run fcei``, 2026-11-23); rtol 1e-13
-#: would give 6.1e-7 m at 1030 (``benchmarks/bench_fcei.py``), too close to the 1e-6 m target.
+#: Integration tolerances for every Chapter 4 scenario: tight enough that FCEI's position error
+#: over one orbit stays well below the 1e-6 m target (rtol 1e-13 comes too close to it; the
+#: figures and the command that measures them are in docs/scenarios/chapter4.rst and
+#: benchmarks/README.md).
 RTOL, ATOL = 3e-15, 1e-12
 SAMPLES_PER_ORBIT = 721
 #: The one option of every Chapter 4 scenario.

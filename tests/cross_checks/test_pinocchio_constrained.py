@@ -3,7 +3,7 @@
 For n free-flying rigid bodies and random full-row-rank rows A ν̇ = b, gmuk's UK solution
 (McCann 2020, Eq. 64) must equal ``pin.forwardDynamics(model, data, q, v, τ, J, γ)``, which
 solves ``[M Jᵀ; J 0][a; −λ] = [τ − h; −γ]``: so J = A (columns reordered) and γ = −b; the
-multipliers of Eq. 3 equal ``data.lambda_c`` (ERRATA).
+multipliers of Eq. 3 equal ``data.lambda_c`` (docs/errata.rst).
 """
 
 from __future__ import annotations
