@@ -454,8 +454,10 @@ class _Stepper:
             t_target = t_end
             if step_to_outputs and outs is not None and out_i < outs.size:
                 t_target = min(t_end, outs[out_i])
-            # Land exactly on the target when within a hair of it (no sliver steps).
-            h_try = t_target - t if t_target - t <= h * (1.0 + 1e-6) else h
+            # Land exactly on the target when within a hair of it (no sliver steps); t + h_try
+            # may round to a neighbour of t_target, so the step ends at t_target itself.
+            landing = t_target - t <= h * (1.0 + 1e-6)
+            h_try = t_target - t if landing else h
             if h_try <= 10 * np.finfo(float).eps * max(1.0, abs(t)):
                 raise _StepFailure(f"step size underflow (h = {h_try:.3g} s)")
             K = m.stages(f, t, Y, h_try, f0)
@@ -475,7 +477,7 @@ class _Stepper:
                 h_next = h_try * min(10.0, max(0.2, factor))
             else:
                 h_next = h
-            t_new = t + h_try
+            t_new = t_target if landing else t + h_try
             if dense and outs is not None:
                 hit = outs[out_i:][outs[out_i:] < t_new]
                 if hit.size:

@@ -208,3 +208,16 @@ def test_progress_bar_appears_on_request_and_not_otherwise(capsys):
     system.simulate(state, (0.0, 2.0), progress=False)
     system.simulate(state, (0.0, 2.0))  # default: only on a terminal, and captured is not one
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("method", ["DOP853", "DOPRI5"])
+def test_the_last_step_lands_exactly_on_the_end_time(method):
+    # t + (t_end − t) need not round to t_end when t < t_end/2: the step that lands must end
+    # at t_end itself, or a sliver of ~1e-14 s is left and the run fails with a step-size
+    # underflow. A body at rest has no error to control, so each step is ten times the last
+    # and the last one starts well before t_end/2 (about a quarter of these ends failed).
+    system, state = free_body(V0=np.zeros(6))
+    ends = np.random.default_rng(12).uniform(1.0, 1000.0, 40)
+    for t_end in ends:
+        traj = system.simulate(state, (0.0, t_end), method=method, rtol=1e-6, atol=1e-6)
+        assert traj.success and traj.t[-1] == t_end, t_end
