@@ -5,10 +5,10 @@ For n rigid bodies, ``g̈ = blkdiag(g̈₁, …, g̈ₙ)`` (4n × 4n), ``A`` is 
 in the body accelerations: :meth:`TangentBundleConstraint.rows` gives those rows
 (:func:`gmuk.uk.reachable_rows`), which the System stacks and solves like any other
 constraint's. With ``System(..., tangent_bundle_method="eq80")`` the System instead solves
-Eq. 80 for ``g̈_c`` and recovers ``V̇_c,i = (g_i⁻¹ g̈_c,ii)^∨``. Errata (docs/errata.rst): for general A, B the
-g̈_c of Eq. 80 need not lie in g·se(3) (no control input produces it); gmuk projects each
-diagonal block onto se(3) (skew rotation part, translation column) and reports the size of
-what it discarded.
+Eq. 80 for ``g̈_c`` and recovers ``V̇_c,i = (g_i⁻¹ g̈_c,ii)^∨``. Errata (docs/errata.rst):
+for general A, B the g̈_c of Eq. 80 need not lie in g·se(3) (no control input produces it);
+gmuk projects each diagonal block onto se(3) (skew rotation part, translation column) and
+reports the size of what it discarded.
 """
 
 from __future__ import annotations

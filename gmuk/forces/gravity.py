@@ -10,8 +10,8 @@
   ``L = 3μ/|r|⁵ · r_B × (J r_B)``,
   ``f = −μm/|r|³ · (r_B + 3/(m|r|²) [J + ½(tr J − 5 r̂_Bᵀ J r̂_B) I] r_B)``.
 
-  Errata (docs/errata.rst): correct as printed with r_B = Rᵀr (Eqs. 33/52 write inertial r, where J must be
-  R J Rᵀ); both match point-cloud quadrature to 1e-11.
+  Errata (docs/errata.rst): correct as printed with r_B = Rᵀr (Eqs. 33/52 write inertial r,
+  where J must be R J Rᵀ); both match point-cloud quadrature to 1e-11.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The modified-LVLH reference of McCann (2020), Section 4.1.2, with the corrections of docs/errata.rst."""
+"""The modified-LVLH reference of McCann (2020), Section 4.1.2, corrected (docs/errata.rst)."""
 
 from __future__ import annotations
 
@@ -138,7 +138,8 @@ def test_reference_acceleration_is_two_body_gravity(name):
 
 
 def test_thesis_eq69_as_printed_breaks_the_kinematics():
-    """Errata (docs/errata.rst): with the printed R_{d/P}, ġ = g V^ fails (relative error 2.0 in ω)."""
+    """Errata (docs/errata.rst): with the printed R_{d/P}, ġ = g V^ fails (relative error
+    2.0 in ω)."""
     orbit = fcei_orbit()
     t = sample_times(orbit)
     h = local_step(orbit, t)
@@ -177,8 +178,9 @@ def test_thesis_eq69_as_printed_breaks_the_kinematics():
 
 
 def test_thesis_eq72_translational_part_as_printed_is_not_the_derivative():
-    """Errata (docs/errata.rst): Eq. 72's translational part is R_{d/P}ᵀ v̇_{d/P} − ω^× R_{d/P}ᵀ v_{d/P};
-    the printed R_{d/P}ᵀ v̇_{d/P} + R_{d/P}ᵀ ω^× v_{d/P} does not match d/dt of V_{d/P}."""
+    """Errata (docs/errata.rst): Eq. 72's translational part is
+    R_{d/P}ᵀ v̇_{d/P} − ω^× R_{d/P}ᵀ v_{d/P}; the printed R_{d/P}ᵀ v̇_{d/P} + R_{d/P}ᵀ ω^× v_{d/P}
+    does not match d/dt of V_{d/P}."""
     orbit = fcei_orbit()
     ref = LVLHReference(orbit)
     t = sample_times(orbit)
@@ -291,7 +293,8 @@ def test_section43_initial_condition_reproduces_the_printed_numbers():
 
 
 def test_section43_numbers_are_not_reproduced_with_the_usual_lunar_mu():
-    """Errata (docs/errata.rst): μ = 4.9028e12 gives ḟ = 4.2373e-4 and v₂ = −1355.93, not the printed values."""
+    """Errata (docs/errata.rst): μ = 4.9028e12 gives ḟ = 4.2373e-4 and v₂ = −1355.93, not
+    the printed values."""
     _, V0 = section43_initial_state(MU_MOON_USUAL)
     assert round(V0[2], 8) == 4.2373e-4
     assert round(V0[4], 2) == -1355.93
