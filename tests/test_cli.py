@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import gmuk
-from gmuk import cli, plotting, scenarios
+from gmuk import _plugins, cli, plotting, scenarios
 from gmuk.errors import DefinitionError, GmukError, PluginWarning
 from gmuk.scenarios import Option, OptionError, Scenario, ScenarioResult
 
@@ -90,7 +90,7 @@ def plugins(monkeypatch):
 
     def install(*eps):
         monkeypatch.setattr(
-            scenarios.metadata,
+            _plugins.metadata,
             "entry_points",
             lambda group: list(eps) if group == scenarios.ENTRY_POINT_GROUP else [],
         )
@@ -194,7 +194,7 @@ def test_broken_plugins_warn_and_are_skipped(plugins):
 def test_discovery_is_cached(plugins, monkeypatch):
     calls = []
     plugins()
-    monkeypatch.setattr(scenarios.metadata, "entry_points", lambda group: calls.append(group) or [])
+    monkeypatch.setattr(_plugins.metadata, "entry_points", lambda group: calls.append(group) or [])
     scenarios.refresh()
     scenarios.available()
     scenarios.get("fcei")

@@ -15,12 +15,11 @@ raises an error that lists every installed model.
 from __future__ import annotations
 
 import functools
-import warnings
 from dataclasses import dataclass
-from importlib import metadata
 from typing import Any
 
-from gmuk.errors import DefinitionError, PluginWarning
+from gmuk._plugins import entry_point_plugins, load_target
+from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
 
 __all__ = ["ENTRY_POINT_GROUP", "ForceModelInfo", "available", "create", "get", "refresh"]
@@ -47,48 +46,24 @@ class ForceModelInfo:
     target: str  # "module:attribute"
 
 
-def _load_target(target: str) -> Any:
-    module, _, attr = target.partition(":")
-    obj: Any = __import__(module, fromlist=[attr])
-    for part in attr.split("."):
-        obj = getattr(obj, part)
-    return obj
-
-
 @functools.cache
 def _discover() -> dict[str, ForceModelInfo]:
     found: dict[str, ForceModelInfo] = {}
     for name, target in _BUILTIN.items():
-        found[name] = ForceModelInfo(name, _load_target(target), "gmuk", target)
-    for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
-        dist = getattr(getattr(ep, "dist", None), "name", None) or "unknown distribution"
-        if ep.name in found:
-            warnings.warn(
-                f"force-model plugin {ep.name!r} from {dist} is ignored: the name is "
-                f"taken by {found[ep.name].source}",
-                PluginWarning,
-                stacklevel=3,
-            )
-            continue
-        try:
-            obj = ep.load()
-        except Exception as exc:
-            warnings.warn(
-                f"force-model plugin {ep.name!r} ({ep.value}, from {dist}) failed to "
-                f"load and is skipped: {type(exc).__name__}: {exc}",
-                PluginWarning,
-                stacklevel=3,
-            )
-            continue
-        if not (isinstance(obj, type) and issubclass(obj, ForceModel)):
-            warnings.warn(
-                f"force-model plugin {ep.name!r} ({ep.value}, from {dist}) is skipped: "
-                f"it names {obj!r}, not a gmuk.ForceModel subclass",
-                PluginWarning,
-                stacklevel=3,
-            )
-            continue
-        found[ep.name] = ForceModelInfo(ep.name, obj, dist, ep.value)
+        found[name] = ForceModelInfo(name, load_target(target), "gmuk", target)
+
+    def rejects(name: str, obj: Any) -> str | None:
+        if isinstance(obj, type) and issubclass(obj, ForceModel):
+            return None
+        return f"it names {obj!r}, not a gmuk.ForceModel subclass"
+
+    for name, obj, dist, target in entry_point_plugins(
+        ENTRY_POINT_GROUP,
+        "force-model plugin",
+        lambda n: found[n].source if n in found else None,
+        rejects,
+    ):
+        found[name] = ForceModelInfo(name, obj, dist, target)
     return found
 
 

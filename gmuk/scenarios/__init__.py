@@ -36,14 +36,13 @@ from __future__ import annotations
 
 import functools
 import keyword
-import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from importlib import metadata
 from pathlib import Path
 from typing import Any, TypeVar
 
-from gmuk.errors import DefinitionError, GmukError, PluginWarning
+from gmuk._plugins import entry_point_plugins, load_target
+from gmuk.errors import DefinitionError, GmukError
 from gmuk.trajectory import Trajectory
 
 __all__ = [
@@ -337,52 +336,32 @@ class Scenario:
 # --- registry ----------------------------------------------------------------------------------
 
 
-def _load_target(target: str) -> Any:
-    # the force-model registry's importer of "module:attribute" targets
-    from gmuk.forces.registry import _load_target as load
-
-    return load(target)
-
-
 @functools.cache
 def _discover() -> dict[str, tuple[Scenario, str]]:
     """name → (scenario, source): gmuk's first, then plugins'."""
     found: dict[str, tuple[Scenario, str]] = {}
     for name, target in SCENARIOS.items():
-        scenario = _load_target(target)
+        scenario = load_target(target)
         if not isinstance(scenario, Scenario) or scenario.name != name:
             raise DefinitionError(
                 f"SCENARIOS[{name!r}] = {target!r} must name a Scenario called {name!r}"
             )
         found[name] = (scenario, "gmuk")
-    for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
-        dist = getattr(getattr(ep, "dist", None), "name", None) or "unknown distribution"
-        where = f"scenario plugin {ep.name!r} ({ep.value}, from {dist})"
-        if ep.name in found:
-            warnings.warn(
-                f"{where} is ignored: the name is taken by {found[ep.name][1]}",
-                PluginWarning,
-                stacklevel=3,
-            )
-            continue
-        try:
-            obj = ep.load()
-        except Exception as exc:
-            warnings.warn(
-                f"{where} failed to load and is skipped: {type(exc).__name__}: {exc}",
-                PluginWarning,
-                stacklevel=3,
-            )
-            continue
-        if not isinstance(obj, Scenario) or obj.name != ep.name:
-            what = (
-                f"a Scenario named {obj.name!r}"
-                if isinstance(obj, Scenario)
-                else f"{obj!r}, not a gmuk.scenarios.Scenario"
-            )
-            warnings.warn(f"{where} is skipped: it names {what}", PluginWarning, stacklevel=3)
-            continue
-        found[ep.name] = (obj, dist)
+
+    def rejects(name: str, obj: Any) -> str | None:
+        if isinstance(obj, Scenario) and obj.name == name:
+            return None
+        if isinstance(obj, Scenario):
+            return f"it names a Scenario named {obj.name!r}"
+        return f"it names {obj!r}, not a gmuk.scenarios.Scenario"
+
+    for name, obj, dist, _ in entry_point_plugins(
+        ENTRY_POINT_GROUP,
+        "scenario plugin",
+        lambda n: found[n][1] if n in found else None,
+        rejects,
+    ):
+        found[name] = (obj, dist)
     return found
 
 

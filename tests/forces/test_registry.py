@@ -7,6 +7,7 @@ from importlib import metadata
 import pytest
 
 import gmuk
+from gmuk import _plugins
 from gmuk.errors import DefinitionError, PluginWarning
 from gmuk.forces import registry
 
@@ -19,7 +20,7 @@ def fake_plugins(monkeypatch):
 
     def install(*eps):
         monkeypatch.setattr(
-            registry.metadata, "entry_points", lambda group: [ep for ep in eps if ep.group == group]
+            _plugins.metadata, "entry_points", lambda group: [ep for ep in eps if ep.group == group]
         )
         registry.refresh()
 
@@ -70,7 +71,7 @@ def test_discovery_is_cached(fake_plugins, monkeypatch):
         return []
 
     fake_plugins()
-    monkeypatch.setattr(registry.metadata, "entry_points", counting)
+    monkeypatch.setattr(_plugins.metadata, "entry_points", counting)
     registry.refresh()
     registry.available()
     registry.get("gravity_gradient")
