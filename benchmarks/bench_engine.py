@@ -132,7 +132,7 @@ def breakdown() -> None:
     st = S.state(g={"a": np.eye(4)}, V={"a": ref.xi})
     A, b = S._stack_rows(st, check_finite=False)
     z = S._zero_loads
-    args = (st.V, z, A, b, S._uk_params, np.empty(4 * 6 + 6 + 3))
+    args = (st.V, z, A, b, S.solver._params, np.empty(4 * 6 + 6 + 3))
     compiled = entry(_uk_kernels.uk_rigid_c)
     parts = [
         ("System.accelerations (whole call)", lambda: S.accelerations(st)),

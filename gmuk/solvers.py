@@ -189,22 +189,19 @@ class UKSolver(abc.ABC):
 
     def __init__(self, system: System) -> None:
         self.system = system
+        # (modeled, unmodeled, control, z_dot) at a state: generalized loads (n_dof,) and
+        # the controllers' state rates
+        self._loads = system._generalized_forces
 
     @classmethod
     def problems(cls, system: System) -> list[str]:
         """What this strategy cannot solve in ``system`` (empty if it can)."""
         return []
 
-    def accelerations(
-        self,
-        state: State,
-        modeled: FloatArray,
-        unmodeled: FloatArray,
-        control: FloatArray,
-        z_dot: FloatArray,
-    ) -> Accelerations:
-        """Free, constraint and total accelerations from the generalized loads (n_dof,)."""
-        return self._general(state, modeled, unmodeled, control, z_dot, None)
+    def accelerations(self, state: State) -> Accelerations:
+        """Free, constraint and total accelerations at ``state`` (the System has checked
+        that the state is one of its own)."""
+        return self._general(state, *self._loads(state), None)
 
     def _general(
         self,
@@ -335,6 +332,7 @@ class FusedRigidSolver(DenseSolver):
         self._n = lay.n_dof
         self._V_shape = (lay.n_rigid, 6)
         self._zero_loads = system._zero_loads
+        self._stack_rows = system._stack_rows
         # QR-eligible rows have s ≤ n, so the SVD's default rcond would be n·ε.
         rc = system.rcond if system.rcond is not None else max(lay.n_dof, 1) * _EPS
         self._params = _uk_kernels.rigid_params(
@@ -359,16 +357,10 @@ class FusedRigidSolver(DenseSolver):
             out.append("the fused solve needs at least one constraint")
         return out
 
-    def accelerations(
-        self,
-        state: State,
-        modeled: FloatArray,
-        unmodeled: FloatArray,
-        control: FloatArray,
-        z_dot: FloatArray,
-    ) -> Accelerations:
+    def accelerations(self, state: State) -> Accelerations:
         """The compiled path, or the dense one for rows it cannot certify."""
-        rows = A, b = self.system._stack_rows(state, check_finite=False)
+        modeled, unmodeled, control, z_dot = self._loads(state)
+        rows = A, b = self._stack_rows(state, check_finite=False)
         s = b.size
         if 0 < s <= QR_MAX_ROWS:
             V = state.V
@@ -384,7 +376,7 @@ class FusedRigidSolver(DenseSolver):
                 _uk_rigid_c(V, modeled, A, b, self._params, out)
             else:
                 _uk_kernels.uk_rigid(V, modeled, A, b, self._params, out)
-            status = out[-1]
+            status = float(out[-1])  # a Python float compares faster than a numpy scalar
             if status == _INCONSISTENT:
                 self.check_consistency(state, float(out[-3]), float(out[-2]))
             if status == _SOLVED or status == _INCONSISTENT:

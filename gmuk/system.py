@@ -158,6 +158,7 @@ class System:
         self._build_mass()
         self._build_index()
         self.solver: UKSolver = solver_cls(self)
+        self._accelerations = self.solver.accelerations
 
     def _choose_solver(self, solver: object, sparse: bool | str) -> type[UKSolver]:
         """The solve strategy: given, or chosen from the options and the parts."""
@@ -555,7 +556,7 @@ class System:
         """
         if state.layout is not self.layout and state.layout != self.layout:
             raise DefinitionError("state belongs to another System (layouts differ)")
-        return self.solver.accelerations(state, *self._generalized_forces(state))
+        return self._accelerations(state)
 
     # ------------------------------------------------------------------ simulation
     def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:
