@@ -189,8 +189,7 @@ class UKSolver(abc.ABC):
 
     def __init__(self, system: System) -> None:
         self.system = system
-        # (modeled, unmodeled, control, z_dot) at a state: generalized loads (n_dof,) and
-        # the controllers' state rates
+        # (modeled, unmodeled) generalized forces (n_dof,) of the force models at a state
         self._loads = system._generalized_forces
 
     @classmethod
@@ -204,24 +203,20 @@ class UKSolver(abc.ABC):
         return self._general(state, *self._loads(state), None)
 
     def _general(
-        self,
-        state: State,
-        modeled: FloatArray,
-        unmodeled: FloatArray,
-        control: FloatArray,
-        z_dot: FloatArray,
-        rows: Any,
+        self, state: State, modeled: FloatArray, unmodeled: FloatArray, rows: Any
     ) -> Accelerations:
+        """Free acceleration, the solve, then the controllers (which may read the modeled
+        acceleration ν̇_a + ν̇_c) and the plant-only loads."""
         system = self.system
         a = system._free(state, modeled)
+        ac, lam, rank, residual, unreachable = self.solve(state, a, rows)
+        total = a + ac
+        control, z_dot = system._controls(state, total)
         if system._plant_only_loads:
             extra = system._apply_Minv(unmodeled + control)
-            total = a + extra
+            total = total + extra
         else:
             extra = np.zeros_like(a)
-            total = a.copy()
-        ac, lam, rank, residual, unreachable = self.solve(state, a, rows)
-        total += ac
         return Accelerations(
             system.layout,
             a,
@@ -332,6 +327,7 @@ class FusedRigidSolver(DenseSolver):
         self._n = lay.n_dof
         self._V_shape = (lay.n_rigid, 6)
         self._zero_loads = system._zero_loads
+        self._zero_z = system._zero_z
         self._stack_rows = system._stack_rows
         # QR-eligible rows have s ≤ n, so the SVD's default rcond would be n·ε.
         rc = system.rcond if system.rcond is not None else max(lay.n_dof, 1) * _EPS
@@ -359,7 +355,7 @@ class FusedRigidSolver(DenseSolver):
 
     def accelerations(self, state: State) -> Accelerations:
         """The compiled path, or the dense one for rows it cannot certify."""
-        modeled, unmodeled, control, z_dot = self._loads(state)
+        modeled, unmodeled = self._loads(state)
         rows = A, b = self._stack_rows(state, check_finite=False)
         s = b.size
         if 0 < s <= QR_MAX_ROWS:
@@ -388,16 +384,16 @@ class FusedRigidSolver(DenseSolver):
                         "extra": self._zero_loads,  # no plant-only loads here
                         "total": out[2 * n : 3 * n],
                         "constraint_force": out[3 * n : 4 * n],
-                        "control_force": control,
+                        "control_force": self._zero_loads,  # no controllers here
                         "unmodeled_force": unmodeled,
                         "multipliers": out[4 * n : 4 * n + s],
                         "residual": float(out[-3]),
                         "rank": s,
                         "unreachable": 0.0,
-                        "z_dot": z_dot,
+                        "z_dot": self._zero_z,
                     }
                 )
-        return self._general(state, modeled, unmodeled, control, z_dot, rows)
+        return self._general(state, modeled, unmodeled, rows)
 
 
 class SparseSolver(UKSolver):

@@ -239,7 +239,7 @@ class System:
                     f"controllers[{i}] must be a gmuk.Controller; got {type(ctl).__name__}"
                 )
             else:
-                check_refs(f"controller {ctl.name!r}", ctl.bodies, BodyKind)
+                check_refs(f"controller {ctl.name!r}", ctl.bodies, ctl.body_kinds)
         return problems
 
     # ------------------------------------------------------------------ set-up
@@ -440,26 +440,37 @@ class System:
             a[e] = Q[e] / self._m_euclid
         return a
 
-    def _generalized_forces(
-        self, state: State
-    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        if not (self.forces or self.controllers):  # shared, read-only zeros
-            return self._zero_loads, self._zero_loads, self._zero_loads, self._zero_z
+    def _generalized_forces(self, state: State) -> tuple[FloatArray, FloatArray]:
+        """The modeled and the unmodeled generalized forces (n_dof,) of the force models."""
+        if not self.forces:  # shared, read-only zeros
+            return self._zero_loads, self._zero_loads
         n = self.layout.n_dof
-        modeled, unmodeled, control = np.zeros(n), np.zeros(n), np.zeros(n)
+        modeled, unmodeled = np.zeros(n), np.zeros(n)
         for f, bodies in zip(self.forces, self._force_bodies, strict=True):
             target = modeled if f.modeled else unmodeled
             for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
                 self._add(target, body, w, f"force {f.name!r}")
+        return modeled, unmodeled
+
+    def _controls(self, state: State, modeled: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The controllers' generalized forces (n_dof,) and internal-state rates, given the
+        modeled acceleration ν̇_a + ν̇_c (n_dof,), which controllers may ask for."""
+        if not self.controllers:
+            return self._zero_loads, self._zero_z
+        control = np.zeros(self.layout.n_dof)
         z_dot = np.zeros(self.layout.n_control)
+        modeled.setflags(write=False)
         for c, bodies, sl in zip(
             self.controllers, self._ctrl_bodies, self._ctrl_slices, strict=True
         ):
-            u, zd = c.control(state, state.z[sl])
+            if c.uses_modeled_acceleration:
+                u, zd = c.control(state, state.z[sl], modeled)
+            else:
+                u, zd = c.control(state, state.z[sl])
             for body, w in zip(bodies, u, strict=True):
                 self._add(control, body, np.asarray(w, dtype=float), f"controller {c.name!r}")
             z_dot[sl] = np.asarray(zd, dtype=float).reshape(-1)
-        return modeled, unmodeled, control, z_dot
+        return control, z_dot
 
     def _add(self, target: FloatArray, body: Body, w: FloatArray, who: str) -> None:
         s = self.layout.slot(body)

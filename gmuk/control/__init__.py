@@ -1,5 +1,17 @@
 """Controllers: feedback wrenches on the plant, with internal states."""
 
 from gmuk.control.base import Controller
+from gmuk.control.morse_lyapunov import (
+    MorseLyapunovController,
+    TrackingErrors,
+    morse_s,
+    morse_s_rate_matrix,
+)
 
-__all__ = ["Controller"]
+__all__ = [
+    "Controller",
+    "MorseLyapunovController",
+    "TrackingErrors",
+    "morse_s",
+    "morse_s_rate_matrix",
+]

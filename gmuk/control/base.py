@@ -4,19 +4,23 @@ A controller adds a wrench u to each of its bodies from the state (McCann 2020, 
 the "u" beside τ), and may carry internal states z (e.g. the integral of an error) that the
 integrator advances with ż from :meth:`Controller.control`. Control wrenches act on the
 plant: the Udwadia–Kalaba solve does not see them (it computes the constraint acceleration of
-the nominal, modeled system; Chapter 5).
+the nominal, modeled system; Chapter 5). The System evaluates controllers after that solve,
+so a controller that declares ``uses_modeled_acceleration = True`` is also handed the modeled
+acceleration ν̇_a + ν̇_c (free plus constraint, under the modeled forces) that its wrench adds
+to.
 """
 
 from __future__ import annotations
 
 import abc
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from gmuk._frozen import FreezesInSystem
 from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError
 
 if TYPE_CHECKING:
@@ -38,6 +42,10 @@ class Controller(FreezesInSystem, abc.ABC):
     name : str, optional
     """
 
+    #: Whether :meth:`control` takes the modeled acceleration as a third argument.
+    uses_modeled_acceleration: ClassVar[bool] = False
+    #: The kinds of body this controller can act on (default: every kind).
+    body_kinds: ClassVar[frozenset[BodyKind]] = frozenset(BodyKind)
     _bodies: tuple[Body | str, ...]
     _name: str
     n_states: int
@@ -68,13 +76,19 @@ class Controller(FreezesInSystem, abc.ABC):
         return np.zeros(self.n_states)
 
     @abc.abstractmethod
-    def control(self, state: State, z: FloatArray) -> tuple[Sequence[Any], Any]:
+    def control(
+        self, state: State, z: FloatArray, *modeled: FloatArray
+    ) -> tuple[Sequence[Any], Any]:
         """Control wrenches and internal-state rates.
 
         Parameters
         ----------
         state : State
         z : ndarray, shape (n_states,)
+        modeled : ndarray, shape (n_dof,)
+            Only for a controller with ``uses_modeled_acceleration = True``: the modeled
+            acceleration ν̇_a + ν̇_c of every body (System order, read-only; slice a body's
+            with ``state.layout.slot(body)``), to which the control acceleration adds.
 
         Returns
         -------

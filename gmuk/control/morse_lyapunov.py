@@ -1,0 +1,451 @@
+"""Morse–Lyapunov backstepping tracking control on TSE(3) (McCann 2020, Section 5).
+
+A :class:`MorseLyapunovController` drives one rigid body onto a nominal motion
+(g_n, V_n, V̇_n) given by any :class:`gmuk.reference.ReferenceTrajectory`, from disturbed
+initial states and against forces the Udwadia–Kalaba model does not know. Its wrench acts
+on the plant beside the UK constraint wrench, which the System computes from the modeled
+dynamics; the controller is handed that modeled acceleration and adds to it.
+
+The corrected law (default)
+---------------------------
+Errors are those of the configuration error ``E_g = g_n⁻¹ g`` on SE(3):
+
+* ``E_R = R_nᵀ R`` and the position error in the **body** frame ``q = Rᵀ(r − r_n)``;
+* ``E_V = V − Ad_{E_g⁻¹} V_n = [E_ω; E_v]``, the body twist of E_g (``Ė_g = E_g E_V^``),
+  so that ``Ė_R = E_R E_ω^`` and ``q̇ = −E_ω × q + E_v``;
+* ``s(E_R) = Σᵢ aᵢ (E_Rᵀ eᵢ)^× eᵢ`` (Eq. 84), ``l = [s; q]`` (Eq. 83) and
+  ``ψ = E_V + K₁ l`` (Eq. 82) with ``K₁ = blkdiag(k₁₁ I₃, k₁₂ I₃)``;
+* ``ṡ = (tr(A E_Rᵀ) I − E_Rᵀ A) E_ω``, so ``l̇ = [ṡ; −E_ω × q + E_v]``.
+
+The control assigns the error dynamics
+
+``ψ̇ = −K₂ ψ − κ [0; q] − k_I z``,  ``ż = ψ``  (z: the integral of ψ, the controller's state)
+
+through ``u = 𝕀 (V̇_cmd − V̇_model)`` with
+``V̇_cmd = Ad_{E_g⁻¹} V̇_n − ad_{E_V} Ad_{E_g⁻¹} V_n − K₁ l̇ − K₂ ψ − κ [0; q] − k_I z``
+and V̇_model the modeled acceleration (free plus UK constraint). With
+
+``W = c tr(A − A E_R) + (κ/2) |q|² + ½ |ψ|² + (k_I/2) |z|²``,
+
+``Ẇ = −ψᵀ K₂ ψ + c ψ_ω·s − c k₁₁ |s|² − κ k₁₂ |q|²``, which is ≤ 0 whenever
+``c < 4 k₁₁ λ_min(K₂₁)`` (the rotational block is then a positive definite quadratic form in
+(|ψ_ω|, |s|)); c is an analysis weight only (it is not in u). By LaSalle, the closed loop
+tends to ψ = 0, q = 0, z = 0, s(E_R) = 0; with distinct aᵢ the last holds only at
+E_R = I (the minimum of the Morse function) and at the three saddles E_R = diag(1, −1, −1),
+diag(−1, 1, −1), diag(−1, −1, 1), whose stable manifolds have zero measure: (E_g, E_V) =
+(I, 0) is almost globally asymptotically stable. The derivation is in the documentation's
+Chapter 5 theory page.
+
+Departures from McCann (2020), Eq. 81 (errata, "Section 5.1 controller")
+-----------------------------------------------------------------------
+* The printed law takes the inertial position error r − r_n beside a body-frame velocity
+  error V − V_n; its proof's ``Ė_r = E_R E_v`` is false, and on the LVLH orbit (whose
+  nominal attitude flips an axis) the translational loop diverges. Here the position error is
+  body-frame, q = Rᵀ(r − r_n), in ψ and in the κ term alike, and E_V is the twist of E_g.
+* The printed k₃ = 1000 is both the integral gain and the Morse weight; as an integral gain
+  it leaves an almost undamped oscillation. The integral gain is its own parameter k_I
+  (default 1e-8 s⁻², near critical damping of the slow translational mode), and the Morse
+  weight c of W is an analysis parameter (default 0.2).
+* The printed ``−(ad*_V 𝕀V − ad*_{V_n} 𝕀V_n)`` cancels the gyroscopic terms of a plant driven
+  by the *nominal* UK wrench; gmuk's UK wrench is computed at the actual state, so the law
+  uses the modeled acceleration instead (the exact feedforward in either case).
+
+The printed law is kept as ``variant="thesis"`` (with its k₃ = 1000) for reproducing the
+thesis and showing its divergence.
+
+References
+----------
+McCann (2020), Eqs. (81)–(90); Nazari, Maadani, Butcher & Yucelen (2018), "Morse–Lyapunov-
+based control of rigid body motion on TSE(3) via backstepping", AIAA SciTech,
+doi:10.2514/6.2018-0602; Khalil (2002), *Nonlinear Systems*, §14.3 (backstepping).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray
+from gmuk.bodies import BodyKind, RigidBody
+from gmuk.control.base import Controller
+from gmuk.errors import DefinitionError
+from gmuk.lie import se3
+from gmuk.reference import ReferenceTrajectory
+
+if TYPE_CHECKING:
+    from gmuk.state import State
+    from gmuk.trajectory import Trajectory
+
+__all__ = ["MorseLyapunovController", "TrackingErrors", "morse_s", "morse_s_rate_matrix"]
+
+_EYE3 = np.eye(3)
+#: Eq. 90's printed robust gain κ₂ (with its O/‖r‖⁴ bound).
+KAPPA2_THESIS = -39.0 / 2.0
+
+
+def morse_s(E_R: FloatArray, a: FloatArray) -> FloatArray:
+    """``s(E_R) = Σᵢ aᵢ (E_Rᵀ eᵢ)^× eᵢ`` (McCann 2020, Eq. 84), shape (3,).
+
+    Zero exactly at the critical points of the Morse function ``tr(A − A E_R)``: E_R = I and,
+    for distinct aᵢ, the three rotations by π about the axes eᵢ.
+    """
+    # (E_Rᵀ eᵢ) is row i of E_R; Σ aᵢ uᵢ × eᵢ written out per component
+    u = E_R * a[:, None]
+    return np.array([u[2, 1] - u[1, 2], u[0, 2] - u[2, 0], u[1, 0] - u[0, 1]])
+
+
+def morse_s_rate_matrix(E_R: FloatArray, a: FloatArray) -> FloatArray:
+    """Q with ``ṡ = Q E_ω`` when ``Ė_R = E_R E_ω^``: ``Q = tr(A E_Rᵀ) I − E_Rᵀ A``, (3, 3)."""
+    AEt = E_R.T * a[None, :]  # E_Rᵀ A
+    return float(np.trace(AEt)) * _EYE3 - AEt
+
+
+@dataclass(frozen=True)
+class TrackingErrors:
+    """The errors of one pose and twist against the nominal, as the corrected law uses them.
+
+    Attributes
+    ----------
+    E_R : ndarray (3, 3)
+        R_nᵀ R.
+    q : ndarray (3,)
+        Rᵀ(r − r_n): position error in the body frame (m).
+    E_V : ndarray (6,)
+        V − Ad_{E_g⁻¹} V_n: twist of the configuration error (rad/s, m/s), body frame.
+    Vn_B : ndarray (6,)
+        Ad_{E_g⁻¹} V_n: the nominal twist in the body frame.
+    Ad_inv : ndarray (6, 6)
+        Ad_{E_g⁻¹}.
+    s : ndarray (3,)
+        s(E_R) of Eq. 84.
+    psi : ndarray (6,)
+        ψ = E_V + K₁ [s; q] (Eq. 82).
+    """
+
+    E_R: FloatArray
+    q: FloatArray
+    E_V: FloatArray
+    Vn_B: FloatArray
+    Ad_inv: FloatArray
+    s: FloatArray
+    psi: FloatArray
+
+    @property
+    def attitude_error(self) -> float:
+        """Rotation angle of E_R (rad), in [0, π]."""
+        c = 0.5 * (float(np.trace(self.E_R)) - 1.0)
+        return float(np.arccos(min(1.0, max(-1.0, c))))
+
+
+def _gain_vector(value: Any, name: str, *, positive: bool = True) -> FloatArray:
+    """A scalar or (3,) gain as a finite (3,) vector, > 0 (or ≥ 0)."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise DefinitionError(f"{name} must be a number or 3 numbers; got {value!r}") from None
+    if v.ndim == 0:
+        v = np.full(3, float(v))
+    if v.shape != (3,) or not np.isfinite(v).all():
+        raise DefinitionError(
+            f"{name} must be a finite scalar or a (3,) array; got shape {v.shape}: {value!r}"
+        )
+    if positive and not (v > 0).all():
+        raise DefinitionError(f"{name} must be > 0; got {v.tolist()}")
+    if not positive and not (v >= 0).all():
+        raise DefinitionError(f"{name} must be ≥ 0; got {v.tolist()}")
+    return v
+
+
+def _gain_scalar(value: Any, name: str, *, positive: bool = True) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise DefinitionError(f"{name} must be a number; got {value!r}") from None
+    if not np.isfinite(v) or (v <= 0 if positive else v < 0):
+        raise DefinitionError(f"{name} must be finite and {'>' if positive else '≥'} 0; got {v!r}")
+    return v
+
+
+class MorseLyapunovController(Controller):
+    """Morse–Lyapunov backstepping tracking of a nominal motion (McCann 2020, Eqs. 81–90).
+
+    Parameters
+    ----------
+    body : RigidBody
+        The controlled rigid body (the object: the law needs its mass properties).
+    reference : ReferenceTrajectory
+        The nominal motion (g_n, V_n, V̇_n), e.g. :class:`gmuk.orbits.LVLHReference`.
+    k11, k12 : float
+        Virtual-control gains of K₁ (1/s): rotation and translation. Defaults as in
+        Section 5.1: 0.099999, 0.999999.
+    k21, k22 : float or array_like (3,)
+        Diagonal gains of K₂ (1/s): rotation and translation. Defaults as in Section 5.1:
+        1.1 and (0.05, 0.05, 1)·1e-5.
+    kappa : float
+        κ (1/s²), the translational coupling of ψ̇ and the weight of ½|q|² in W. Default as
+        in Section 5.1: 0.0002.
+    a : array_like (3,)
+        Morse weights A = diag(a), distinct and > 0. Default (3, 2, 1) as in Section 5.1.
+    k_integral : float
+        Integral gain k_I (1/s², ≥ 0) of ``−k_I ∫ψ``. Default 1e-8, **not** the printed
+        k₃ = 1000 (errata: an almost undamped 31.6 rad/s oscillation); 1e-8 is near critical
+        damping of the slow translational mode (rate ≈ κ/k₁₂ + k₂₂).
+    morse_weight : float
+        c, the weight of the Morse function in W (analysis only, not in u). Must satisfy
+        c < 4 k₁₁ min(k₂₁) for Ẇ ≤ 0. Default 0.2.
+    robust : bool
+        Add Eq. 90's term ``−𝕀 κ₂ O/‖r‖⁴`` (O a 6-vector of ones). As printed, with
+        κ₂ = −39/2, it is of order 1e-25 m/s² on a lunar orbit (the units of κ₂ are not
+        stated; the term is kept as printed for reproduction); pass ``bound`` for a bound of
+        your own.
+    kappa2 : float
+        κ₂ of Eq. 90 (default −39/2).
+    bound : callable (t, g, V) → (6,), optional
+        Replaces ``κ₂ O/‖r‖⁴`` in the robust term by a user bound (rad/s², m/s²); implies
+        ``robust=True``.
+    variant : {"corrected", "thesis"}
+        "thesis" is Eq. 81 as printed (inertial position error, V − V_n, the printed
+        ``−(ad*_V 𝕀V − ad*_{V_n} 𝕀V_n)`` and integral gain k₃ = ``k_integral``, default then
+        1000); it diverges on the LVLH orbit and is kept to show it.
+    name : str, optional
+
+    Notes
+    -----
+    The internal state z (6,) is ∫ψ dt, starting at zero. The wrench returned is
+    ``[u_L; u_f]`` in the body frame (N·m, N).
+    """
+
+    uses_modeled_acceleration = True
+    body_kinds = frozenset({BodyKind.RIGID})
+
+    def __init__(
+        self,
+        body: RigidBody,
+        reference: ReferenceTrajectory,
+        *,
+        k11: float = 0.099999,
+        k12: float = 0.999999,
+        k21: Any = 1.1,
+        k22: Any = (0.05e-5, 0.05e-5, 1e-5),
+        kappa: float = 0.0002,
+        a: Sequence[float] = (3.0, 2.0, 1.0),
+        k_integral: float | None = None,
+        morse_weight: float = 0.2,
+        robust: bool = False,
+        kappa2: float = KAPPA2_THESIS,
+        bound: Callable[[float, FloatArray, FloatArray], Any] | None = None,
+        variant: str = "corrected",
+        name: str | None = None,
+    ) -> None:
+        if not isinstance(body, RigidBody):
+            raise DefinitionError(
+                "MorseLyapunovController controls a gmuk.RigidBody (pass the body object: "
+                f"the law needs its mass properties); got {type(body).__name__}: {body!r}"
+            )
+        super().__init__([body], n_states=6, name=name)
+        if not isinstance(reference, ReferenceTrajectory):
+            raise DefinitionError(
+                "reference must be a gmuk.ReferenceTrajectory (e.g. gmuk.orbits.LVLHReference); "
+                f"got {type(reference).__name__}: {reference!r}"
+            )
+        if variant not in ("corrected", "thesis"):
+            raise DefinitionError(f"variant must be 'corrected' or 'thesis'; got {variant!r}")
+        if bound is not None and not callable(bound):
+            raise DefinitionError(f"bound must be a callable (t, g, V) -> (6,); got {bound!r}")
+        aa = np.asarray(a, dtype=float) if np.ndim(a) == 1 else np.full(1, np.nan)
+        if aa.shape != (3,) or not np.isfinite(aa).all() or not (aa > 0).all():
+            raise DefinitionError(f"a must be 3 finite numbers > 0; got {a!r}")
+        if len(set(aa.tolist())) != 3:
+            raise DefinitionError(
+                f"a must be 3 distinct numbers (else s(E_R) vanishes on whole circles of "
+                f"rotations, not at isolated saddles); got {aa.tolist()}"
+            )
+        self.reference = reference
+        self.variant = variant
+        self.k11 = _gain_scalar(k11, "k11")
+        self.k12 = _gain_scalar(k12, "k12")
+        self.k21 = _gain_vector(k21, "k21")
+        self.k22 = _gain_vector(k22, "k22")
+        self.kappa = _gain_scalar(kappa, "kappa")
+        self.a = aa
+        default_ki = 1000.0 if variant == "thesis" else 1e-8
+        self.k_integral = _gain_scalar(
+            default_ki if k_integral is None else k_integral, "k_integral", positive=False
+        )
+        self.morse_weight = _gain_scalar(morse_weight, "morse_weight")
+        limit = 4.0 * self.k11 * float(self.k21.min())
+        if variant == "corrected" and not self.morse_weight < limit:
+            raise DefinitionError(
+                f"morse_weight must be < 4 k11 min(k21) = {limit:.6g} for the Lyapunov rate "
+                f"to be ≤ 0; got {self.morse_weight!r}"
+            )
+        self.robust = bool(robust) or bound is not None
+        try:
+            self.kappa2 = float(kappa2)
+        except (TypeError, ValueError):
+            raise DefinitionError(f"kappa2 must be a number; got {kappa2!r}") from None
+        if not np.isfinite(self.kappa2):
+            raise DefinitionError(f"kappa2 must be finite; got {kappa2!r}")
+        self.bound = bound
+        self._K1 = np.concatenate([np.full(3, self.k11), np.full(3, self.k12)])
+        self._K2 = np.concatenate([self.k21, self.k22])
+        self._I = body.mass_matrix()  # 𝕀 = blkdiag(J, m I₃)
+
+    # ------------------------------------------------------------------ errors
+    def errors(self, t: float, g: FloatArray, V: FloatArray) -> TrackingErrors:
+        """The corrected law's errors at time t (s) for pose g (4, 4) and body twist V (6,)."""
+        ref = self.reference.evaluate(t)
+        return self._errors(g, V, np.asarray(ref.g, float), np.asarray(ref.V, float))
+
+    def _errors(
+        self, g: FloatArray, V: FloatArray, g_n: FloatArray, V_n: FloatArray
+    ) -> TrackingErrors:
+        R, R_n = g[:3, :3], g_n[:3, :3]
+        E_R = R_n.T @ R
+        dr = g[:3, 3] - g_n[:3, 3]
+        q = R.T @ dr
+        E_g_inv = se3._inverse(se3._inverse(g_n) @ g)
+        Ad_inv = se3._Ad(E_g_inv)
+        Vn_B = Ad_inv @ V_n
+        E_V = V - Vn_B
+        s = morse_s(E_R, self.a)
+        psi = E_V + self._K1 * np.concatenate([s, q])
+        return TrackingErrors(E_R, q, E_V, Vn_B, Ad_inv, s, psi)
+
+    # ------------------------------------------------------------------ the law
+    def control(
+        self, state: State, z: FloatArray, *modeled: FloatArray
+    ) -> tuple[list[FloatArray], FloatArray]:
+        """The wrench [u_L; u_f] (body frame, N·m, N) and ż = ψ."""
+        (body,) = self.bodies
+        slot = state.layout.slot(body)
+        g, V = state.g[slot.index], state.V[slot.index]
+        I = self._I
+        a_model = modeled[0][slot.offset : slot.offset + 6]
+        ref = self.reference.evaluate(state.t)
+        g_n = np.asarray(ref.g, dtype=float)
+        V_n = np.asarray(ref.V, dtype=float)
+        Vd_n = np.asarray(ref.V_dot, dtype=float)
+        if self.variant == "thesis":
+            u, psi = self._thesis_law(g, V, g_n, V_n, Vd_n, z, I)
+        else:
+            e = self._errors(g, V, g_n, V_n)
+            E_w, E_v = e.E_V[:3], e.E_V[3:]
+            l_dot = np.concatenate(
+                [morse_s_rate_matrix(e.E_R, self.a) @ E_w, E_v - np.cross(E_w, e.q)]
+            )
+            coupling = np.concatenate([np.zeros(3), self.kappa * e.q])
+            V_dot_cmd = (
+                e.Ad_inv @ Vd_n
+                - se3._ad(e.E_V) @ e.Vn_B
+                - self._K1 * l_dot
+                - self._K2 * e.psi
+                - coupling
+                - self.k_integral * z
+            )
+            u = I @ (V_dot_cmd - a_model)
+            psi = e.psi
+        if self.robust:
+            u = u - I @ self._robust_bound(state.t, g, V)
+        return [u], psi
+
+    def _robust_bound(self, t: float, g: FloatArray, V: FloatArray) -> FloatArray:
+        """Eq. 90's κ₂ O/‖r‖⁴, or the user's bound (6,)."""
+        if self.bound is not None:
+            b = np.asarray(self.bound(t, g, V), dtype=float)
+            if b.shape != (6,) or not np.isfinite(b).all():
+                raise DefinitionError(
+                    f"controller {self.name!r}: bound(t, g, V) must return 6 finite numbers; "
+                    f"got shape {b.shape}"
+                )
+            return b
+        r = g[:3, 3]
+        return np.full(6, self.kappa2 / float(r @ r) ** 2)
+
+    def _thesis_law(
+        self,
+        g: FloatArray,
+        V: FloatArray,
+        g_n: FloatArray,
+        V_n: FloatArray,
+        Vd_n: FloatArray,
+        z: FloatArray,
+        I: FloatArray,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Eq. 81 as printed: E_r = r − r_n (inertial), E_V = V − V_n, the printed
+        gyroscopic difference, integral gain k₃ = k_integral. l̇ is the exact time derivative
+        of l along the motion."""
+        R, R_n = g[:3, :3], g_n[:3, :3]
+        E_R = R_n.T @ R
+        E_r = g[:3, 3] - g_n[:3, 3]
+        E_V = V - V_n
+        s = morse_s(E_R, self.a)
+        psi = E_V + self._K1 * np.concatenate([s, E_r])
+        # Ė_R = E_R ω^ − ω_n^ E_R; ṡ = Σ aᵢ (Ė_Rᵀ eᵢ)^× eᵢ = morse_s(Ė_R) (s is linear in E_R)
+        E_R_dot = E_R @ se3._hat(np.r_[V[:3], 0, 0, 0])[:3, :3] - (
+            se3._hat(np.r_[V_n[:3], 0, 0, 0])[:3, :3] @ E_R
+        )
+        E_r_dot = R @ V[3:] - R_n @ V_n[3:]
+        l_dot = np.concatenate([morse_s(E_R_dot, self.a), E_r_dot])
+        gyro = se3._ad(V).T @ (I @ V) - se3._ad(V_n).T @ (I @ V_n)
+        coupling = np.concatenate([np.zeros(3), self.kappa * (E_R @ E_r)])
+        u = (
+            -I @ (self._K1 * l_dot)
+            - gyro
+            - I @ (self._K2 * psi)
+            - I @ coupling
+            - self.k_integral * (I @ z)
+        )
+        return u, psi
+
+    # ------------------------------------------------------------------ Lyapunov function
+    def lyapunov(self, traj: Trajectory) -> tuple[FloatArray, FloatArray]:
+        """W and its closed-loop rate Ẇ along a Trajectory of the corrected law.
+
+        ``W = c tr(A − A E_R) + (κ/2)|q|² + ½|ψ|² + (k_I/2)|z|²`` and
+        ``Ẇ = −ψᵀK₂ψ + c ψ_ω·s − c k₁₁|s|² − κ k₁₂|q|²`` (the rate when no unmodeled force
+        acts), at every output time.
+
+        Returns
+        -------
+        W : ndarray (N,)
+        W_dot : ndarray (N,)
+        """
+        if self.variant != "corrected":
+            raise DefinitionError("lyapunov() is defined for variant='corrected' only")
+        (body,) = self.bodies
+        name = body if isinstance(body, str) else body.name
+        i = traj.body_names.index(name)
+        c = self.morse_weight
+        W = np.empty(len(traj.t))
+        W_dot = np.empty(len(traj.t))
+        z_all = self._states_of(traj)
+        for k, t in enumerate(traj.t):
+            e = self.errors(float(t), traj.g_NB[k, i], traj.V_B[k, i])
+            z = z_all[k]
+            W[k] = (
+                c * float(np.sum(self.a * (1.0 - np.diag(e.E_R))))
+                + 0.5 * self.kappa * float(e.q @ e.q)
+                + 0.5 * float(e.psi @ e.psi)
+                + 0.5 * self.k_integral * float(z @ z)
+            )
+            W_dot[k] = (
+                -float(e.psi @ (self._K2 * e.psi))
+                + c * float(e.psi[:3] @ e.s)
+                - c * self.k11 * float(e.s @ e.s)
+                - self.kappa * self.k12 * float(e.q @ e.q)
+            )
+        return W, W_dot
+
+    def _states_of(self, traj: Trajectory) -> FloatArray:
+        """This controller's z (N, 6) in a Trajectory (controllers' states are concatenated
+        in System order; a System with this controller alone has exactly these)."""
+        if traj.z.shape[1] != 6:
+            raise DefinitionError(
+                "the trajectory carries controller states of several controllers; "
+                "pass one made by a System whose only controller is this one"
+            )
+        return traj.z
