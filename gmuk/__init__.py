@@ -38,7 +38,7 @@ from gmuk.constraints import (
     TangentBundleConstraint,
     VirtualPairT2,
 )
-from gmuk.control import Controller
+from gmuk.control import Controller, MorseLyapunovController
 from gmuk.crosscheck import check
 from gmuk.dynamics import spatial_inertia
 from gmuk.forces import (
@@ -77,6 +77,7 @@ __all__ = [
     "GravityGradient",
     "HolonomicConstraint",
     "Layout",
+    "MorseLyapunovController",
     "NonholonomicConstraint",
     "PointMass",
     "PointMassGravity",
