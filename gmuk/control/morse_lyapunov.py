@@ -72,7 +72,7 @@ from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind, RigidBody
 from gmuk.control.base import Controller
 from gmuk.errors import DefinitionError
-from gmuk.lie import se3
+from gmuk.lie import se3, so3
 from gmuk.reference import ReferenceTrajectory
 
 if TYPE_CHECKING:
@@ -335,7 +335,7 @@ class MorseLyapunovController(Controller):
             e = self._errors(g, V, g_n, V_n)
             E_w, E_v = e.E_V[:3], e.E_V[3:]
             l_dot = np.concatenate(
-                [morse_s_rate_matrix(e.E_R, self.a) @ E_w, E_v - np.cross(E_w, e.q)]
+                [morse_s_rate_matrix(e.E_R, self.a) @ E_w, E_v - so3._cross(E_w, e.q)]
             )
             coupling = np.concatenate([np.zeros(3), self.kappa * e.q])
             V_dot_cmd = (

@@ -26,6 +26,7 @@ from gmuk.bodies import BodyKind
 from gmuk.celestial import CelestialBody
 from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
+from gmuk.lie import so3
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
@@ -107,7 +108,7 @@ class GravityGradient(ForceModel):
         r2 = float(r_B @ r_B)
         rn = np.sqrt(r2)
         Jr = J @ r_B
-        L = (3.0 * self.mu / (r2 * r2 * rn)) * np.cross(r_B, Jr)
+        L = (3.0 * self.mu / (r2 * r2 * rn)) * so3._cross(r_B, Jr)
         shape = Jr + 0.5 * (np.trace(J) - 5.0 * float(r_B @ Jr) / r2) * r_B
         f = (-self.mu * m / (r2 * rn)) * (r_B + (3.0 / (m * r2)) * shape)
         return np.concatenate([L, f])

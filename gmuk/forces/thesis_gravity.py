@@ -18,6 +18,7 @@ from gmuk._validation import FloatArray
 from gmuk.errors import DefinitionError, DomainError
 from gmuk.forces.base import ForceModel
 from gmuk.gravity.legendre import legendre_4pi
+from gmuk.lie import so3
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
@@ -269,5 +270,5 @@ class ThesisRadialHarmonicGravity(ForceModel):
         f = f + (mu_r3 * m) * (scalar * r_B + float(np.sum(c * k)) * Jr)
         # Eq. 59
         bracket = 3.0 - float(np.sum(c * (n + 3.0)))
-        L = (self.mu / (r2 * r2 * rn) * bracket) * np.cross(r_B, Jr)
+        L = (self.mu / (r2 * r2 * rn) * bracket) * so3._cross(r_B, Jr)
         return np.concatenate([L, f])

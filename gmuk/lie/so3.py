@@ -34,6 +34,14 @@ _GEN_FLAT = _GEN.reshape(3, 9)
 SKEW_TOL = 1e-9
 
 
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """a × b of two 3-vectors, written out: numpy's cross (axis handling for any shape)
+    costs more than the six products on the right-hand side's hot path."""
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
+
+
 def _hat(w: FloatArray) -> FloatArray:
     return (w @ _GEN_FLAT).reshape((*w.shape[:-1], 3, 3))
 
