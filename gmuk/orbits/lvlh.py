@@ -214,6 +214,9 @@ class LVLHReference(ReferenceTrajectory):
             raise TypeError(f"orbit must be a gmuk.orbits.KeplerOrbit; got {type(orbit).__name__}")
         self._orbit = orbit
         self._R_NP = np.array(orbit.R_NP)
+        # The last evaluation: a constraint and a controller on the same reference ask for
+        # the same time at every right-hand-side evaluation.
+        self._last: tuple[float, ReferenceState] | None = None
 
     @property
     def orbit(self) -> KeplerOrbit:
@@ -235,7 +238,9 @@ class LVLHReference(ReferenceTrajectory):
         -------
         ReferenceState
             ``g`` (4, 4): ``g_d = g_P g_{d/P}`` (m); ``V`` (6,): ``V_d = [ω_d; v_d]`` in the
-            desired body frame (rad/s, m/s); ``V_dot`` (6,): ``V̇_d`` (rad/s², m/s²).
+            desired body frame (rad/s, m/s); ``V_dot`` (6,): ``V̇_d`` (rad/s², m/s²). The
+            arrays are read-only: the last evaluation is kept and handed to the next caller
+            that asks for the same time.
 
         Raises
         ------
@@ -243,6 +248,9 @@ class LVLHReference(ReferenceTrajectory):
             If t is NaN or infinite.
         """
         t = float(t)
+        last = self._last
+        if last is not None and last[0] == t:
+            return last[1]
         if not math.isfinite(t):
             raise NonFiniteError(f"t must be finite; got {t!r}")
         o = self._orbit
@@ -259,7 +267,11 @@ class LVLHReference(ReferenceTrajectory):
         g[3] = (0.0, 0.0, 0.0, 1.0)
         V = np.array([0.0, 0.0, fd, v1, v2, 0.0])
         V_dot = np.array([0.0, 0.0, fdd, o.mu / (r * r) + fd * v2, -fd * v1, 0.0])
-        return ReferenceState(g, V, V_dot)
+        for x in (g, V, V_dot):  # shared with the next caller at the same time: read-only
+            x.flags.writeable = False
+        out = ReferenceState(g, V, V_dot)
+        self._last = (t, out)
+        return out
 
     def relative_to_perifocal(self, t: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``g_{d/P}``, ``V_{d/P}`` and ``V̇_{d/P}`` (McCann 2020, Eqs. 68, 71, 72 corrected).
