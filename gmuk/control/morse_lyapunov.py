@@ -29,23 +29,28 @@ and V̇_model the modeled acceleration (free plus UK constraint). With
 
 ``Ẇ = −ψᵀ K₂ ψ + c ψ_ω·s − c k₁₁ |s|² − κ k₁₂ |q|²``, which is ≤ 0 whenever
 ``c < 4 k₁₁ λ_min(K₂₁)`` (the rotational block is then a positive definite quadratic form in
-(|ψ_ω|, |s|)); c is an analysis weight only (it is not in u). By LaSalle, the closed loop
+``‖ψ_ω‖`` and ``‖s‖``); c is an analysis weight only (it is not in u). By LaSalle, the closed loop
 tends to ψ = 0, q = 0, z = 0, s(E_R) = 0; with distinct aᵢ the last holds only at
-E_R = I (the minimum of the Morse function) and at the three saddles E_R = diag(1, −1, −1),
-diag(−1, 1, −1), diag(−1, −1, 1), whose stable manifolds have zero measure: (E_g, E_V) =
-(I, 0) is almost globally asymptotically stable. The derivation is in the documentation's
+E_R = I (the minimum of the Morse function) and at E_R = diag(1, −1, −1), diag(−1, 1, −1)
+(its saddles) and diag(−1, −1, 1) (its maximum): unstable equilibria of the closed loop whose
+stable manifolds have zero measure, so (E_g, E_V) = (I, 0) is almost globally asymptotically
+stable. The derivation is in the documentation's
 Chapter 5 theory page.
 
 Departures from McCann (2020), Eq. 81 (errata, "Section 5.1 controller")
------------------------------------------------------------------------
+------------------------------------------------------------------------
 * The printed law takes the inertial position error r − r_n beside a body-frame velocity
   error V − V_n; its proof's ``Ė_r = E_R E_v`` is false, and on the LVLH orbit (whose
   nominal attitude flips an axis) the translational loop diverges. Here the position error is
   body-frame, q = Rᵀ(r − r_n), in ψ and in the κ term alike, and E_V is the twist of E_g.
 * The printed k₃ = 1000 is both the integral gain and the Morse weight; as an integral gain
-  it leaves an almost undamped oscillation. The integral gain is its own parameter k_I
-  (default 1e-8 s⁻², near critical damping of the slow translational mode), and the Morse
-  weight c of W is an analysis parameter (default 0.2).
+  it leaves an almost undamped oscillation. The integral gain is its own parameter k_I,
+  **off by default**: with the Section 5.1 gains any k_I > 0 adds a translational mode near
+  k_I/κ, slower than the convergence it is meant to help unless k_I ≳ 1e-8 s⁻² (critical
+  damping), where the position error overshoots (at two FCEI orbits from the Section 5.1
+  start: 0.56 m with k_I = 0, 12 m with 1e-10, 189 m with 1e-8, per-axis linear model).
+  Without it a constant unmodeled acceleration d leaves a steady position error ≈ d/κ.
+  The Morse weight c of W is an analysis parameter (default 0.2).
 * The printed ``−(ad*_V 𝕀V − ad*_{V_n} 𝕀V_n)`` cancels the gyroscopic terms of a plant driven
   by the *nominal* UK wrench; gmuk's UK wrench is computed at the actual state, so the law
   uses the modeled acceleration instead (the exact feedforward in either case).
@@ -135,9 +140,8 @@ class TrackingErrors:
 
     @property
     def attitude_error(self) -> float:
-        """Rotation angle of E_R (rad), in [0, π]."""
-        c = 0.5 * (float(np.trace(self.E_R)) - 1.0)
-        return float(np.arccos(min(1.0, max(-1.0, c))))
+        """Rotation angle of E_R (rad), in [0, π] (from so3.log: exact at small angles too)."""
+        return float(np.linalg.norm(so3.log(self.E_R)))
 
 
 def _gain_vector(value: Any, name: str, *, positive: bool = True) -> FloatArray:
@@ -190,9 +194,10 @@ class MorseLyapunovController(Controller):
     a : array_like (3,)
         Morse weights A = diag(a), distinct and > 0. Default (3, 2, 1) as in Section 5.1.
     k_integral : float
-        Integral gain k_I (1/s², ≥ 0) of ``−k_I ∫ψ``. Default 1e-8, **not** the printed
-        k₃ = 1000 (errata: an almost undamped 31.6 rad/s oscillation); 1e-8 is near critical
-        damping of the slow translational mode (rate ≈ κ/k₁₂ + k₂₂).
+        Integral gain k_I (1/s², ≥ 0) of ``−k_I ∫ψ``. Default 0 (off), **not** the printed
+        k₃ = 1000 (errata: an almost undamped 31.6 rad/s oscillation). With the default
+        gains a k_I > 0 adds a slow mode near k_I/κ (see the module docstring); about 1e-8
+        critically damps the slow translational mode and removes constant biases.
     morse_weight : float
         c, the weight of the Morse function in W (analysis only, not in u). Must satisfy
         c < 4 k₁₁ min(k₂₁) for Ẇ ≤ 0. Default 0.2.
@@ -271,7 +276,7 @@ class MorseLyapunovController(Controller):
         self.k22 = _gain_vector(k22, "k22")
         self.kappa = _gain_scalar(kappa, "kappa")
         self.a = aa
-        default_ki = 1000.0 if variant == "thesis" else 1e-8
+        default_ki = 1000.0 if variant == "thesis" else 0.0
         self.k_integral = _gain_scalar(
             default_ki if k_integral is None else k_integral, "k_integral", positive=False
         )
