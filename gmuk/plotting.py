@@ -16,7 +16,14 @@ import numpy as np
 from gmuk._validation import FloatArray
 from gmuk.trajectory import Trajectory
 
-__all__ = ["compare_body", "plot_body", "plot_components", "plot_panels"]
+__all__ = [
+    "compare_body",
+    "plot_against_nominal",
+    "plot_body",
+    "plot_components",
+    "plot_log_lines",
+    "plot_panels",
+]
 
 _AXES = ("1", "2", "3")
 
@@ -229,3 +236,152 @@ def plot_panels(
         paths.append(path)
     plt.close(fig)
     return paths
+
+
+def _time_axis(ax: Any, t: FloatArray, t_scale: str, t_linear: float) -> None:
+    """Linear time axis, or symmetric-log (linear on [0, t_linear], logarithmic beyond),
+    spanning exactly the data."""
+    if t_scale == "symlog":
+        ax.set_xscale("symlog", linthresh=t_linear)
+    elif t_scale != "linear":
+        raise ValueError(f"t_scale must be 'linear' or 'symlog'; got {t_scale!r}")
+    ax.set_xlim(float(t[0]), float(t[-1]))
+
+
+def _save(plt: Any, fig: Any, out: Path, formats: Sequence[str]) -> list[Path]:
+    paths = []
+    for fmt in formats:
+        path = out.with_suffix(f".{fmt}")
+        fig.savefig(path, dpi=150)
+        paths.append(path)
+    plt.close(fig)
+    return paths
+
+
+def plot_against_nominal(
+    t: FloatArray,
+    y: FloatArray,
+    nominal: FloatArray | None,
+    ylabels: Sequence[str],
+    title: str,
+    out: Path,
+    formats: Sequence[str] = ("png",),
+    *,
+    label: str = "run",
+    nominal_label: str = "nominal",
+    norm: tuple[str, FloatArray] | None = None,
+    t_label: str = "t (s)",
+    t_scale: str = "linear",
+    t_linear: float = 1.0,
+) -> list[Path]:
+    """One figure of a vector quantity against its nominal (McCann 2020, Chapter 5 style).
+
+    Row k shows component k of the run (solid, colour k) and of the nominal (black, dashed);
+    an optional last row shows a norm (e.g. the error against the nominal) on a logarithmic
+    axis, where non-positive values are left out.
+
+    Parameters
+    ----------
+    t : ndarray (N,)
+        Abscissa (s unless ``t_label`` says otherwise).
+    y : ndarray (N, 3)
+        The run's components.
+    nominal : ndarray (N, 3) or None
+        The nominal's components at the same times (no dashed lines when None).
+    ylabels : sequence of 3 str
+        Row labels with units, e.g. ``"r1 (km)"``.
+    title : str
+    out : Path
+        Output path without suffix; one file per format is written beside it.
+    formats : sequence of str
+    label, nominal_label : str
+        Legend entries.
+    norm : (str, ndarray (N,)), optional
+        Label with units and values of the log-scaled last row.
+    t_label : str
+    t_scale : {"linear", "symlog"}
+        "symlog" is linear on [0, ``t_linear``] and logarithmic beyond: a fast transient and a
+        slow convergence in one figure.
+    t_linear : float
+        End of the linear part of a "symlog" axis (same unit as t).
+
+    Returns
+    -------
+    list of Path
+    """
+    plt = _pyplot()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    rows = 3 + (norm is not None)
+    fig, axes = plt.subplots(
+        rows, 1, sharex=True, figsize=(7.5, 1.9 * rows + 1.0), constrained_layout=True
+    )
+    for k in range(3):
+        ax = axes[k]
+        ax.plot(t, y[:, k], color=f"C{k}", lw=1.3, label=label)
+        if nominal is not None:
+            ax.plot(t, nominal[:, k], color="k", ls="--", lw=1.0, label=nominal_label)
+        ax.set_ylabel(ylabels[k])
+        ax.grid(True, alpha=0.3)
+        if nominal is not None:
+            ax.legend(loc="best", fontsize=7)
+    if norm is not None:
+        ax = axes[3]
+        values = np.asarray(norm[1], dtype=float)
+        ax.plot(t, np.where(values > 0, values, np.nan), color="C3", lw=1.3)
+        ax.set_yscale("log")
+        ax.set_ylabel(norm[0])
+        ax.grid(True, which="both", alpha=0.3)
+    _time_axis(axes[-1], t, t_scale, t_linear)
+    axes[-1].set_xlabel(t_label)
+    fig.suptitle(title)
+    return _save(plt, fig, out, formats)
+
+
+def plot_log_lines(
+    t: FloatArray,
+    lines: Sequence[tuple[str, FloatArray, dict[str, Any]]],
+    ylabel: str,
+    title: str,
+    out: Path,
+    formats: Sequence[str] = ("png",),
+    *,
+    t_label: str = "t (s)",
+    t_scale: str = "linear",
+    t_linear: float = 1.0,
+) -> list[Path]:
+    """One panel of positive quantities on a logarithmic axis (non-positive values are left
+    out), e.g. the error norms of several runs.
+
+    Parameters
+    ----------
+    t : ndarray (N,)
+    lines : sequence of (label, y (N,), matplotlib line keywords)
+    ylabel : str
+        With units.
+    title : str
+    out : Path
+        Output path without suffix.
+    formats : sequence of str
+    t_label : str
+    t_scale : {"linear", "symlog"}
+    t_linear : float
+        End of the linear part of a "symlog" axis.
+
+    Returns
+    -------
+    list of Path
+    """
+    plt = _pyplot()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(7.5, 4.0), constrained_layout=True)
+    for label, y, style in lines:
+        values = np.asarray(y, dtype=float)
+        ax.plot(t, np.where(values > 0, values, np.nan), label=label, **{"lw": 1.3, **style})
+    ax.set_yscale("log")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+    _time_axis(ax, t, t_scale, t_linear)
+    ax.set_xlabel(t_label)
+    ax.legend(loc="best", fontsize=8)
+    fig.suptitle(title)
+    return _save(plt, fig, out, formats)

@@ -70,6 +70,8 @@ SCENARIOS: dict[str, str] = {
     "ucei": "gmuk.scenarios.ucei:SCENARIO",
     "uceis": "gmuk.scenarios.uceis:SCENARIO",
     "uceim": "gmuk.scenarios.uceim:SCENARIO",
+    "fccl": "gmuk.scenarios.fccl:SCENARIO",
+    "unmodeled": "gmuk.scenarios.unmodeled:SCENARIO",
 }
 
 #: Entry-point group through which other packages register scenarios.
