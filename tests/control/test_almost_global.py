@@ -31,8 +31,8 @@ too long for hundreds of runs. A case passes at T when
   ≈ ½|ψ_v|² ≈ 1e6–1e8, would hide) never increase between output times by more than 1e-9
   of their initial values (integration error), and Ẇ is ≤ 0 at every output time;
 * the position error at T is below 0.9 of its initial value (the linear analysis of the
-  slow pair gives 0.880–0.885 in 600 s; velocity errors ≤ 1 m/s shift the position by
-  about 1 m against ≥ 1 km).
+  slow mode gives 0.8815–0.8866 in 600 s with the default k_I = 0; velocity errors
+  ≤ 1 m/s shift the position by about 1 m against ≥ 1 km).
 
 The default suite runs 16 cases; ``pytest -m slow`` runs 200 (the campaign whose outcome
 docs/theory/chapter5.rst reports).
