@@ -27,14 +27,14 @@ angular-velocity error 0.087 rad/s and the inertial velocity error 13.2 m/s.
 
 Span
 ----
-With the default gains the slow translational dynamics are ``ψ̇ ≈ −(k₂₂ + κ/k₁₂) ψ − k_I z``,
-``ż = ψ``: with k_I = 1e-8 s⁻² a (nearly) critically damped pair at λ ≈ 1e-4 s⁻¹. From z(0) = 0
-the position error behaves as (1 − λt) e^{−λt}: it passes close to zero (14 m) near
-t = 1/λ ≈ 1e4 s, overshoots to ≈ 660 m near 2e4 s and stays above 1 m until 1.165e5 s
-(5.1 orbits). The default span, :data:`ORBITS` = 6, covers that. Without the integral term
-(``k_integral=0``) the error decays as e^{−(κ/k₁₂ + k₂₂)t} ≈ e^{−2.1e-4 t} and falls below
-1 m at 4.15e4 s (1.83 orbits).
-The attitude error falls below 1e-3 rad after 21 s either way.
+With the default gains (integral term off) the slow translational error decays as
+e^{−(κ/k₁₂ + k₂₂)t} ≈ e^{−2.1e-4 t}: the 5.1 km fall below 1 m at 4.15e4 s (1.83 orbits), and
+the default span, :data:`ORBITS` = 2, covers that. The attitude error falls below 1e-3 rad
+after 21 s. With the integral gain k_I = 1e-8 s⁻² (``k_integral=1e-8``) the slow dynamics
+``ψ̇ ≈ −(k₂₂ + κ/k₁₂) ψ − k_I z``, ``ż = ψ`` are a (nearly) critically damped pair at
+λ ≈ 1e-4 s⁻¹; from z(0) = 0 the position error behaves as (1 − λt) e^{−λt}: it passes close to
+zero (14 m) near t = 1/λ ≈ 1e4 s, overshoots to ≈ 660 m near 2e4 s and stays above 1 m until
+1.165e5 s (5.13 orbits).
 
 Integration
 -----------
@@ -42,16 +42,16 @@ The closed loop has fast stable modes (rates ≈ 1 s⁻¹: k₂₁ = 1.1 s⁻¹ 
 the slow translational ones, so explicit steps are limited by stability to ≈ 2.5 s whatever
 the tolerance. DOPRI5 at rtol = atol = 1e-8 (:data:`RTOL`) with steps ≤ 2 s
 (:data:`MAX_STEP`) is the cheapest setting measured that keeps the step control off the edge
-of the stability interval: without the bound the steps oscillate there (190 rejected steps in
+of the stability interval: without the bound the steps oscillate there (191 rejected steps in
 the first 5000 s) and the Morse–Lyapunov torque after the transient carries 1e-3 N·m of noise;
 with it, none are rejected and the noise is 6e-5 N·m (3.8e-6 N·m at rtol 1e-10 for 1.5 times
 the evaluations). Output times (:func:`time_grid`): 11 points on [0, 1] s, then geometric to
 the end, merged with :data:`SAMPLES_PER_ORBIT` uniform points per orbit; DOPRI5 steps exactly
 onto them. The nominal runs at the Chapter 4 tolerances (DOP853, rtol 3e-15, atol 1e-12).
 
-The attitude error levels off at 6.1e-9 rad, at every tolerance from 1e-8 to 1e-11: it is not
-integration error but the integral term's rotational mode, ψ_ω ≈ −(k_I/k₂₁) z_ω, which decays
-at k_I/k₂₁ ≈ 9e-9 s⁻¹; with ``k_integral=0`` the attitude error ends at 4.5e-13 rad.
+With k_I = 1e-8 the attitude error levels off at 6.1e-9 rad, at every tolerance from 1e-8 to
+1e-11: not integration error but the integral term's rotational mode, ψ_ω ≈ −(k_I/k₂₁) z_ω,
+which decays at k_I/k₂₁ ≈ 9e-9 s⁻¹; without the integral term it ends at 4.5e-13 rad.
 
 Outputs
 -------
@@ -77,8 +77,8 @@ Quantities
 
 Command line
 ------------
-``gmuk run fccl`` (six orbits, ``--orbits``; ``--k-integral 0`` for the loop without
-its integral term), ``gmuk run fccl --baumgarte true`` to add the
+``gmuk run fccl`` (two orbits, ``--orbits``; ``--k-integral 1e-8`` for the loop with an
+integral term), ``gmuk run fccl --baumgarte true`` to add the
 UK + Baumgarte runs, ``gmuk run fccl --help``.
 
 References
@@ -163,12 +163,12 @@ RTOL = 1e-8
 #: that the step-size control does not oscillate at its edge (module docstring).
 MAX_STEP = 2.0
 #: Default span, in periods of the FCEI orbit.
-ORBITS = 6.0
+ORBITS = 2.0
 #: Stabilisation of the nominal run against integration drift (:func:`simulate_nominal`):
 #: critically damped at ω_n = 1e-3 rad/s, well above the orbit rate (≤ 4.2e-4 rad/s).
 NOMINAL_BAUMGARTE = gmuk.Baumgarte.critical(1e-3)
-#: The controller's integral gain k_I (1/s²): its default.
-K_INTEGRAL = 1e-8
+#: The controller's integral gain k_I (1/s²): its default (off).
+K_INTEGRAL = 0.0
 #: Uniform output points per orbit, beside the geometric ones of the transient.
 SAMPLES_PER_ORBIT = 361
 #: Geometric output points from 1 s to the end (the transient is resolved to ≈ 2 %).
@@ -179,13 +179,13 @@ POSITION_THRESHOLD = 1.0
 #: UK + Baumgarte designs compared with the controller: (label, ω_n of the three rotation
 #: rows, ω_n of the three translation rows), rad/s, critically damped (α = 2ω_n, β = ω_n²).
 #: "matched" settles attitude and position about when the controller (default gains) does,
-#: "quick" about when the controller without its integral term does; "orbit_rate" has a
-#: translational ω_n near the orbit rate (1.9e-4 to 4.2e-4 rad/s), where the rotating-frame
-#: coupling of the body-frame errors keeps the in-plane position error from converging (see
+#: "slow" about when the controller with k_I = 1e-8 does; "orbit_rate" has a translational
+#: ω_n near the orbit rate (1.9e-4 to 4.2e-4 rad/s), where the rotating-frame coupling of the
+#: body-frame errors keeps the in-plane position error from converging (see
 #: docs/scenarios/chapter5.rst).
 BAUMGARTE_DESIGNS: tuple[tuple[str, float, float], ...] = (
-    ("matched", 0.43, 4e-4),
-    ("quick", 0.43, 6e-4),
+    ("matched", 0.43, 6e-4),
+    ("slow", 0.43, 4e-4),
     ("orbit_rate", 0.43, 3e-4),
 )
 
@@ -493,15 +493,15 @@ def run(
     Parameters
     ----------
     orbits : float
-        Span, in periods of the FCEI orbit (22 696 s); six by default (with the default
-        gains the position error stays below 1 m from 5.1 orbits on; module docstring).
+        Span, in periods of the FCEI orbit (22 696 s); two by default (with the default
+        gains the position error stays below 1 m from 1.83 orbits on; module docstring).
     baumgarte : bool
         Also run the UK + Baumgarte designs of :data:`BAUMGARTE_DESIGNS` (no controller)
         and add their figures to the summary as ``baumgarte_<label>_<key>``.
     rtol : float
         rtol = atol of the closed-loop DOPRI5 runs.
     k_integral : float
-        The controller's integral gain k_I (1/s², ≥ 0); default its own, 1e-8.
+        The controller's integral gain k_I (1/s², ≥ 0); default its own, 0 (off).
     """
     system, ctl, orbit = build(k_integral=k_integral)
     assert ctl is not None
