@@ -81,14 +81,15 @@ from typing import Any
 import numpy as np
 
 import gmuk
-from gmuk import gravity, plotting
+from gmuk import plotting
 from gmuk._validation import FloatArray
 from gmuk.errors import DefinitionError
 from gmuk.forces import SphericalHarmonicGravity, ThesisRadialHarmonicGravity
-from gmuk.gravity import MOON_MU, SphericalHarmonicField, load_gfc
+from gmuk.gravity import SphericalHarmonicField
 from gmuk.orbits import KeplerOrbit, LVLHReference
 from gmuk.scenarios import Option, Scenario, ScenarioResult, comma_separated, positive_float
 from gmuk.scenarios import _lvlh as common
+from gmuk.scenarios._fields import DEFAULT_FIELD, lunar_field
 from gmuk.trajectory import Trajectory
 
 __all__ = [
@@ -120,7 +121,6 @@ MODELS: tuple[str, ...] = ("correct", "thesis")
 #: Thesis-model P̄ normalisations (:class:`~gmuk.forces.ThesisRadialHarmonicGravity`).
 THESIS_NORMALIZATIONS: tuple[str, ...] = ("thesis_eq26c_intended", "thesis_eq26c", "4pi")
 #: The lunar field used unless ``field`` says otherwise: shipped with gmuk, to degree 150.
-DEFAULT_FIELD = "GRGM660PRIM"
 #: Periselene and aposelene altitudes (m) and inclination (rad) of Section 3.4.
 PERISELENE_ALTITUDE = 90e3
 APOSELENE_ALTITUDE = 130e3
@@ -180,28 +180,7 @@ def load_field(
         name that is neither a shipped field nor a file; a field that is not the Moon's.
     """
     degs = _check_degrees(degrees)
-    if isinstance(field, SphericalHarmonicField):
-        sh, note = field, f"{field.name} (given as a field, degree {field.degree})"
-    else:
-        text = os.fspath(field)
-        shipped = {info.name.upper(): info.name for info in gravity.available()}
-        if isinstance(field, str) and text.upper() in shipped:
-            sh = gravity.load(shipped[text.upper()])
-            note = f"{sh.name} (shipped with gmuk, degree {sh.degree})"
-        elif Path(text).is_file():
-            sh = load_gfc(text)
-            note = f"{sh.name} (from {text}, degree {sh.degree})"
-        else:
-            raise DefinitionError(
-                f"{NAME}: field {text!r} (--field) is neither a field shipped with gmuk "
-                f"({', '.join(shipped.values())}) nor an existing file; give a shipped name "
-                "or the path of a lunar ICGEM .gfc file"
-            )
-    if not math.isclose(sh.mu, MOON_MU, rel_tol=1e-3):
-        raise DefinitionError(
-            f"{NAME}: field {note} is not lunar (GM {sh.mu:.6g} m³/s², the Moon's is "
-            f"{MOON_MU:.6g}); give a lunar field such as {DEFAULT_FIELD}"
-        )
+    sh, note = lunar_field(field, NAME)
     if max(degs) > sh.degree:
         raise DefinitionError(
             f"{NAME}: degree {max(degs)} requested but field {note} stops at {sh.degree}; "

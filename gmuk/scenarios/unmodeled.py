@@ -64,7 +64,6 @@ High-degree gravity models from GRAIL primary mission data, *J. Geophys. Res. Pl
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -73,16 +72,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 import gmuk
-from gmuk import gravity, plotting
+from gmuk import plotting
 from gmuk._validation import FloatArray
 from gmuk.celestial import CelestialBody
 from gmuk.control import MorseLyapunovController
 from gmuk.errors import DefinitionError
 from gmuk.forces import ForceModel
-from gmuk.gravity import MOON_MU, SphericalHarmonicField, load_gfc
+from gmuk.gravity import SphericalHarmonicField
 from gmuk.orbits import LVLHReference, fcei_orbit
 from gmuk.scenarios import Option, Scenario, ScenarioResult, boolean, fccl, positive_float
 from gmuk.scenarios import _lvlh as common
+from gmuk.scenarios._fields import DEFAULT_FIELD, lunar_field
 from gmuk.trajectory import Trajectory
 
 if TYPE_CHECKING:
@@ -108,7 +108,6 @@ DESCRIPTION = (
 )
 BODY = fccl.BODY
 #: The lunar field used unless ``field`` says otherwise (shipped with gmuk, degree 150).
-DEFAULT_FIELD = "GRGM660PRIM"
 #: Default truncation degree of the perturbation.
 DEGREE = 10
 #: Controlled-run integration (DOPRI5), rtol = atol.
@@ -222,28 +221,7 @@ def load_field(
     """
     if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or degree < 2:
         raise DefinitionError(f"{NAME}: degree (--degree) must be an integer >= 2; got {degree!r}")
-    if isinstance(field, SphericalHarmonicField):
-        sh, note = field, f"{field.name} (given as a field, degree {field.degree})"
-    else:
-        text = os.fspath(field)
-        shipped = {info.name.upper(): info.name for info in gravity.available()}
-        if isinstance(field, str) and text.upper() in shipped:
-            sh = gravity.load(shipped[text.upper()])
-            note = f"{sh.name} (shipped with gmuk, degree {sh.degree})"
-        elif Path(text).is_file():
-            sh = load_gfc(text)
-            note = f"{sh.name} (from {text}, degree {sh.degree})"
-        else:
-            raise DefinitionError(
-                f"{NAME}: field {text!r} (--field) is neither a field shipped with gmuk "
-                f"({', '.join(shipped.values())}) nor an existing file; give a shipped name "
-                "or the path of a lunar ICGEM .gfc file"
-            )
-    if not math.isclose(sh.mu, MOON_MU, rel_tol=1e-3):
-        raise DefinitionError(
-            f"{NAME}: field {note} is not lunar (GM {sh.mu:.6g} m³/s², the Moon's is "
-            f"{MOON_MU:.6g}); give a lunar field such as {DEFAULT_FIELD}"
-        )
+    sh, note = lunar_field(field, NAME)
     if degree > sh.degree:
         raise DefinitionError(
             f"{NAME}: degree {degree} requested but field {note} stops at {sh.degree}"
