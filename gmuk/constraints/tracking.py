@@ -73,7 +73,7 @@ class ConfigurationTracking(Constraint):
     baumgarte : Baumgarte, optional
         Adds ``−α e_V − β e_g`` to b (errors from :func:`tracking_errors`), so that the
         linearised error obeys ``ë + αė + βe = 0`` (McCann 2020, Eq. 4) when the reference
-        turns slowly against the gains (|ω_d| ≪ α, √β): the terms act in the body frame
+        turns slowly against the gains (``‖ω_d‖ ≪ α, √β``): the terms act in the body frame
         while Eq. 67 prescribes g̈, and a reference turning at a rate near √β (an orbit-rate
         design on the LVLH orbit) couples the axes; see docs/scenarios/chapter5.rst.
     name : str, optional
