@@ -58,13 +58,7 @@ def _figure(
     if len(series) > 1:
         axes[0].legend(loc="best", fontsize=8)
     fig.suptitle(title)
-    paths = []
-    for fmt in formats:
-        path = out.with_suffix(f".{fmt}")
-        fig.savefig(path, dpi=150)
-        paths.append(path)
-    plt.close(fig)
-    return paths
+    return _save(plt, fig, out, formats)
 
 
 def _quantities(traj: Trajectory, body: str) -> dict[str, tuple[FloatArray, list[str], str]]:
@@ -229,13 +223,7 @@ def plot_panels(
     axes[-1, 0].set_xlabel(t_label)
     axes[0, 0].legend(loc="best", fontsize=7, ncol=2)
     fig.suptitle(title)
-    paths = []
-    for fmt in formats:
-        path = out.with_suffix(f".{fmt}")
-        fig.savefig(path, dpi=150)
-        paths.append(path)
-    plt.close(fig)
-    return paths
+    return _save(plt, fig, out, formats)
 
 
 def _time_axis(ax: Any, t: FloatArray, t_scale: str, t_linear: float) -> None:
