@@ -168,9 +168,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _run(argv[1:])
         args = _parser().parse_args(argv)
         if args.command == "list":
-            for scenario, source in scenarios.available():
+            found = scenarios.available()
+            width = max([8, *(len(scenario.name) for scenario, _ in found)])
+            for scenario, source in found:
                 origin = "" if source == "gmuk" else f" [plugin: {source}]"
-                print(f"{scenario.name:<8} {scenario.description}{origin}")
+                print(f"{scenario.name:<{width}} {scenario.description}{origin}")
             return 0
         if args.command == "check":
             return _check(args)

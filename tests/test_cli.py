@@ -114,7 +114,9 @@ def test_a_scenario_registered_in_one_line_runs_with_its_declared_options(
 ):
     assert scenarios.get("tumble") is TUMBLE
     assert cli.main(["list"]) == 0
-    assert f"tumble   {TUMBLE.description}" in capsys.readouterr().out
+    listing = capsys.readouterr().out
+    assert f"tumble    {TUMBLE.description}" in listing  # names padded to the longest
+    assert "unmodeled Ch. 5" in listing
     out = tmp_path / "tumble"
     argv = ["run", "tumble", "--spin", "2", "--moments", "1,2,2.5", "--out", str(out)]
     assert cli.main(argv) == 0
