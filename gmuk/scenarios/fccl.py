@@ -89,7 +89,7 @@ McCann (2020), Section 5.1, Eqs. (81)–(89), Figures 5.1–5.10; the errata (``
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -533,6 +533,36 @@ def non_negative_float(text: str) -> float:
 # --- figures -----------------------------------------------------------------------------------
 
 
+def state_figures(
+    fig: Callable[..., None],
+    traj: Trajectory,
+    nominal: Trajectory,
+    norms: dict[str, FloatArray],
+    *,
+    first: int,
+    titles: tuple[str, str, str, str],
+    attitude_label: str,
+) -> None:
+    """Position, velocity, attitude and angular velocity of a run against the nominal, with
+    their error norms (:func:`tracking_norms`), as figures ``first`` … ``first + 3`` of
+    Chapter 5 through a scenario's ``fig(key, y, y_n, ylabels, title, norm)``."""
+    a, n = traj.body(BODY), nominal.body(BODY)
+    axes = ("1", "2", "3")
+    specs = (
+        ("position", a.position / 1e3, n.position / 1e3, "r{} (km)", "‖r − r_n‖ (m)", "position_m"),
+        ("velocity", a.velocity, n.velocity, "v{} (m/s)", "‖v − v_n‖ (m/s)", "velocity_m_s"),
+        ("attitude", *euler_degrees(traj, nominal), "", attitude_label, "attitude_rad"),
+        ("angular_velocity", a.omega, n.omega, "ω{} (rad/s)", "‖E_ω‖ (rad/s)", "omega_rad_s"),
+    )
+    for k, (stem, y, y_n, unit, norm_label, key) in enumerate(specs):
+        ylabels = (
+            ["ψ (deg)", "θ (deg)", "φ (deg)"]
+            if stem == "attitude"
+            else [unit.format(i) for i in axes]
+        )
+        fig(f"fig5_{first + k:02d}_{stem}", y, y_n, ylabels, titles[k], (norm_label, norms[key]))
+
+
 def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list[Path]:
     """Figures 5.1–5.10, the Lyapunov function and, with Baumgarte runs, the error norms of
     every run (time axis linear on [0, 1] s, logarithmic beyond)."""
@@ -569,36 +599,19 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
             )
         )
 
-    fig(
-        "fig5_01_position",
-        a.position / 1e3,
-        n.position / 1e3,
-        [f"r{i} (km)" for i in axes],
-        "Fig. 5.1 FCCL position in N",
-        ("‖r − r_n‖ (m)", e["position_m"]),
-    )
-    fig(
-        "fig5_02_velocity",
-        a.velocity,
-        n.velocity,
-        [f"v{i} (m/s)" for i in axes],
-        "Fig. 5.2 FCCL velocity in N",
-        ("‖v − v_n‖ (m/s)", e["velocity_m_s"]),
-    )
-    fig(
-        "fig5_03_attitude",
-        *euler_degrees(traj, nominal),
-        ["ψ (deg)", "θ (deg)", "φ (deg)"],
-        "Fig. 5.3 FCCL attitude: 3-2-1 Euler angles of R_NB",
-        ("attitude error (rad)", e["attitude_rad"]),
-    )
-    fig(
-        "fig5_04_angular_velocity",
-        a.omega,
-        n.omega,
-        [f"ω{i} (rad/s)" for i in axes],
-        "Fig. 5.4 FCCL angular velocity, body frame",
-        ("‖E_ω‖ (rad/s)", e["omega_rad_s"]),
+    state_figures(
+        fig,
+        traj,
+        nominal,
+        e,
+        first=1,
+        titles=(
+            "Fig. 5.1 FCCL position in N",
+            "Fig. 5.2 FCCL velocity in N",
+            "Fig. 5.3 FCCL attitude: 3-2-1 Euler angles of R_NB",
+            "Fig. 5.4 FCCL angular velocity, body frame",
+        ),
+        attitude_label="attitude error (rad)",
     )
     fig(
         "fig5_05_uk_translational_control",

@@ -378,36 +378,19 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
             )
         )
 
-    fig(
-        "fig5_11_position",
-        a.position / 1e3,
-        n.position / 1e3,
-        [f"r{i} (km)" for i in axes],
-        "Fig. 5.11 Position under unmodeled dynamics, in N",
-        ("‖r − r_n‖ (m)", e["position_m"]),
-    )
-    fig(
-        "fig5_12_velocity",
-        a.velocity,
-        n.velocity,
-        [f"v{i} (m/s)" for i in axes],
-        "Fig. 5.12 Velocity under unmodeled dynamics, in N",
-        ("‖v − v_n‖ (m/s)", e["velocity_m_s"]),
-    )
-    fig(
-        "fig5_13_attitude",
-        *fccl.euler_degrees(ctl, nom),
-        ["ψ (deg)", "θ (deg)", "φ (deg)"],
-        "Fig. 5.13 Attitude under unmodeled dynamics: 3-2-1 Euler angles",
-        ("attitude deviation (rad)", e["attitude_rad"]),
-    )
-    fig(
-        "fig5_14_angular_velocity",
-        a.omega,
-        n.omega,
-        [f"ω{i} (rad/s)" for i in axes],
-        "Fig. 5.14 Angular velocity under unmodeled dynamics, body frame",
-        ("‖E_ω‖ (rad/s)", e["omega_rad_s"]),
+    fccl.state_figures(
+        fig,
+        ctl,
+        nom,
+        e,
+        first=11,
+        titles=(
+            "Fig. 5.11 Position under unmodeled dynamics, in N",
+            "Fig. 5.12 Velocity under unmodeled dynamics, in N",
+            "Fig. 5.13 Attitude under unmodeled dynamics: 3-2-1 Euler angles",
+            "Fig. 5.14 Angular velocity under unmodeled dynamics, body frame",
+        ),
+        attitude_label="attitude deviation (rad)",
     )
     fig(
         "fig5_15_uk_translational_control",
