@@ -30,6 +30,7 @@ from pathlib import Path
 from gmuk import scenarios
 from gmuk.errors import GmukError
 from gmuk.scenarios import OptionError, Scenario
+from gmuk.trajectory import write_text_atomic
 
 __all__ = ["main"]
 
@@ -139,7 +140,7 @@ def _run(argv: Sequence[str]) -> int:
         "wall_time_s": elapsed,
         **result.summary,
     }
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str) + "\n")
+    write_text_atomic(out / "summary.json", json.dumps(summary, indent=2, default=str) + "\n")
     extra = scenario.write_data(result, out) if scenario.write_data is not None else []
     figures = [] if args.no_plots else scenario.figures(result, out, formats)
     shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)

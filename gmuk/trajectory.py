@@ -12,6 +12,10 @@ computed).
 from __future__ import annotations
 
 import json
+import os
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
@@ -120,8 +124,15 @@ class Trajectory:
         return BodyTrajectory(self, name)
 
     def save(self, path: str | Path) -> Path:
-        """Save to a compressed ``.npz`` (arrays plus JSON metadata); returns the path."""
+        """Save to a compressed ``.npz`` (arrays plus JSON metadata); returns the path.
+
+        The file is written atomically: to a temporary file in the same folder, then renamed
+        over ``path``, so a run stopped while saving leaves the previous file (or none), never
+        a half-written one.
+        """
         path = Path(path)
+        if path.suffix != ".npz":
+            path = path.with_suffix(path.suffix + ".npz")
         meta = {
             "format_version": _FORMAT_VERSION,
             "body_names": list(self.body_names),
@@ -132,8 +143,10 @@ class Trajectory:
             "stats": self.stats,
         }
         arrays = {k: getattr(self, k) for k in _ARRAYS}
-        np.savez_compressed(path, meta=np.array(json.dumps(meta)), **arrays)
-        return path if path.suffix == ".npz" else path.with_suffix(path.suffix + ".npz")
+        with atomic_write(path) as tmp:
+            with open(tmp, "wb") as fh:
+                np.savez_compressed(fh, meta=np.array(json.dumps(meta)), **arrays)
+        return path
 
     def to_csv(self, path: str | Path) -> Path:
         """Write a CSV: t, then per rigid body position (m), 3-2-1 Euler angles (rad), ω and
@@ -253,6 +266,29 @@ class BodyTrajectory:
         if s.kind != "rigid":
             raise DefinitionError(f"{self.name!r} is a {s.kind} body, not a rigid body")
         return int(s.index)
+
+
+@contextmanager
+def atomic_write(path: str | Path) -> Iterator[Path]:
+    """A temporary path beside ``path`` to write to; renamed over ``path`` when the block
+    ends normally, removed when it raises (or is interrupted)."""
+    path = Path(path)
+    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def write_text_atomic(path: str | Path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically (see :func:`atomic_write`)."""
+    with atomic_write(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return Path(path)
 
 
 def load_trajectory(path: str | Path) -> Trajectory:

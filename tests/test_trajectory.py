@@ -74,3 +74,28 @@ def test_csv_export_has_labelled_columns(traj, tmp_path):
     data = np.loadtxt(path, delimiter=",", skiprows=1)
     assert header[0] == "t_s" and "a.psi_rad" in header and "p.vz_m_s" in header
     assert data.shape == (11, len(header))
+
+
+def test_a_save_stopped_midway_leaves_the_previous_file_and_no_partial_one(
+    traj, tmp_path, monkeypatch
+):
+    path = traj.save(tmp_path / "run.npz")
+    before = path.read_bytes()
+
+    def stopped(fh, **arrays):  # writes part of the archive, then the user presses Ctrl-C
+        fh.write(b"PK\x03\x04 half an archive")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez_compressed", stopped)
+    with pytest.raises(KeyboardInterrupt):
+        traj.save(path)
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.npz"]
+    assert gmuk.load_trajectory(path).t.shape == traj.t.shape
+
+
+def test_save_adds_the_npz_suffix_and_writes_no_temporary_file(traj, tmp_path):
+    path = traj.save(tmp_path / "run")
+    assert path.name == "run.npz"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.npz"]
+    assert np.array_equal(gmuk.load_trajectory(path).t, traj.t)
