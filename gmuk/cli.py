@@ -22,10 +22,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
+import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
+from types import FrameType
 
 from gmuk import scenarios
 from gmuk.errors import GmukError
@@ -104,6 +108,32 @@ def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
     return p
 
 
+#: Exit status of a run stopped by a signal: 128 + the signal's number, as shells report it.
+EXIT_STATUS = {signal.SIGINT: 130, signal.SIGTERM: 143}
+
+
+@contextmanager
+def _stopping_signals() -> Iterator[list[int]]:
+    """SIGTERM handled as Ctrl-C (SIGINT) is: as a KeyboardInterrupt, on which the integrator
+    returns the trajectory so far. Yields the list of the signals received (main thread only;
+    elsewhere the handlers cannot be set and the list stays empty)."""
+    received: list[int] = []
+
+    def stop(signum: int, frame: FrameType | None) -> None:
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+    previous = {sig: signal.signal(sig, stop) for sig in EXIT_STATUS}
+    try:
+        yield received
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
 def _run(argv: Sequence[str]) -> int:
     argv = list(argv)
     name = argv.pop(0) if argv and not argv[0].startswith("-") else DEFAULT_SCENARIO
@@ -130,17 +160,32 @@ def _run(argv: Sequence[str]) -> int:
     out = args.out or Path("gmuk-out") / scenario.name
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    result = scenario.run(**options)
+    with _stopping_signals() as received:
+        result = scenario.run(**options)
     elapsed = time.perf_counter() - t0
-    path = result.trajectories[result.primary].save(out / "trajectory.npz")
+    primary = result.trajectories[result.primary]
+    stopped = [k for k, v in result.trajectories.items() if v.status != "success"]
+    path = primary.save(out / "trajectory.npz")
     summary = {
         "scenario": result.name,
+        "status": primary.status if primary.status != "success" or not stopped else "partial",
+        "message": primary.message,
+        "t_reached_s": float(primary.t[-1]) if len(primary.t) else None,
+        **({"signal": signal.Signals(received[0]).name} if received else {}),
+        **({"runs_not_completed": stopped} if stopped else {}),
         "options": {k: list(v) if isinstance(v, tuple) else v for k, v in options.items()},
         **({"orbits": options["orbits"]} if "orbits" in options else {}),
         "wall_time_s": elapsed,
         **result.summary,
     }
     write_text_atomic(out / "summary.json", json.dumps(summary, indent=2, default=str) + "\n")
+    if received:
+        print(
+            f"{result.name}: stopped by {signal.Signals(received[0]).name} at "
+            f"t = {summary['t_reached_s']:.6g} s; wrote {path} and {out / 'summary.json'}",
+            file=sys.stderr,
+        )
+        return EXIT_STATUS[signal.Signals(received[0])]
     extra = scenario.write_data(result, out) if scenario.write_data is not None else []
     figures = [] if args.no_plots else scenario.figures(result, out, formats)
     shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)
@@ -188,6 +233,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except GmukError as exc:
         print(f"gmuk: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # a signal outside the integration: nothing was computed yet
+        print("gmuk: interrupted", file=sys.stderr)
+        return EXIT_STATUS[signal.SIGINT]
 
 
 if __name__ == "__main__":
