@@ -158,7 +158,10 @@ def _run(argv: Sequence[str]) -> int:
     }
     options = scenario.parse_options(given)
     out = args.out or Path("gmuk-out") / scenario.name
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OptionError(f"--out {str(out)!r}: cannot make the output folder: {exc}") from None
     t0 = time.perf_counter()
     with _stopping_signals() as received:
         result = scenario.run(**options)

@@ -291,3 +291,12 @@ def test_unknown_scenario_and_no_command(capsys):
     assert "unknown scenario 'nope'; available: apollo16, fccn" in capsys.readouterr().err
     assert cli.main([]) == 2
     assert "check" in capsys.readouterr().out
+
+
+def test_an_impossible_span_or_output_folder_is_a_clear_error(tmp_path, capsys):
+    assert cli.main(["run", "fcei", "--orbits", "1e300", "--out", str(tmp_path / "a")]) == 2
+    assert "asks for 7.21e+302 output times" in capsys.readouterr().err
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    assert cli.main(["run", "fcei", "--orbits", "0.01", "--out", str(blocker / "sub")]) == 2
+    assert "cannot make the output folder" in capsys.readouterr().err

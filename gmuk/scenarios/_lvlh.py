@@ -18,6 +18,7 @@ import numpy as np
 import gmuk
 from gmuk import plotting
 from gmuk._validation import FloatArray
+from gmuk.errors import DefinitionError
 from gmuk.lie import se3
 from gmuk.orbits import MU_MOON_THESIS_CONSISTENT, KeplerOrbit, LVLHReference
 from gmuk.scenarios import Option, ScenarioResult, positive_float
@@ -50,10 +51,25 @@ def spacecraft(name: str = "spacecraft") -> gmuk.RigidBody:
     return gmuk.RigidBody(name, LM_MASS, LM_INERTIA)
 
 
+#: The most output times a scenario run writes (8 bytes each per stored quantity).
+MAX_OUTPUT_TIMES = 10_000_000
+
+
+def output_count(orbits: float, per_orbit: int) -> int:
+    """``max(2, round(per_orbit · orbits))`` output times, refused beyond MAX_OUTPUT_TIMES
+    (a span of, say, 1e300 orbits is a typo, not a run)."""
+    n = per_orbit * orbits
+    if not n <= MAX_OUTPUT_TIMES:
+        raise DefinitionError(
+            f"orbits = {orbits!r} asks for {n:.3g} output times ({per_orbit} per orbit); at most "
+            f"{MAX_OUTPUT_TIMES:.0e} ({MAX_OUTPUT_TIMES / per_orbit:.6g} orbits) are written"
+        )
+    return max(2, round(n))
+
+
 def time_grid(orbit: KeplerOrbit, orbits: float) -> FloatArray:
     """Output times (s from periselene): SAMPLES_PER_ORBIT per orbit, both ends included."""
-    n = max(2, round(SAMPLES_PER_ORBIT * orbits))
-    return np.linspace(0.0, orbits * orbit.period, n)
+    return np.linspace(0.0, orbits * orbit.period, output_count(orbits, SAMPLES_PER_ORBIT))
 
 
 def fully_constrained(

@@ -369,7 +369,7 @@ def run(
     sh, degs, note = load_field(field, degrees)
     moon = gmuk.CelestialBody.moon(field=sh)
     g0, V0, period = initial_state(initial, moon.mu, moon.radius)
-    t = np.linspace(0.0, orbits * period, max(2, round(SAMPLES_PER_ORBIT * orbits)))
+    t = np.linspace(0.0, orbits * period, common.output_count(orbits, SAMPLES_PER_ORBIT))
 
     trajs = {"uniform": _simulate(gmuk.GravityGradient(moon.mu), g0, V0, t, rtol)}
     for m in models:

@@ -207,7 +207,7 @@ def time_grid(orbit: KeplerOrbit, orbits: float) -> FloatArray:
     """Output times (s): 0, 0.1, …, 1 s, geometric from 1 s to the end, and
     :data:`SAMPLES_PER_ORBIT` uniform points per orbit, merged (all within the span)."""
     end = orbits * orbit.period
-    n = max(2, round(SAMPLES_PER_ORBIT * orbits) + 1)
+    n = common.output_count(orbits, SAMPLES_PER_ORBIT) + 1
     parts = [np.linspace(0.0, end, n), np.linspace(0.0, min(1.0, end), 11)]
     if end > 1.0:
         parts.append(np.geomspace(1.0, end, GEOMETRIC_SAMPLES))
