@@ -367,6 +367,13 @@ def simulate(
     return rec.build(status, message, stepper.stats())
 
 
+def _step_factor(err: float, order: int) -> float:
+    """The step-size factor for a scaled error estimate ``err`` (1: at tolerance): the
+    classical ``0.9 err^(−1/order)``, with err floored so that a zero estimate grows the step
+    by the callers' upper clip."""
+    return 0.9 * (max(err, 1e-10) ** (-1.0 / order))
+
+
 class _StepFailure(RuntimeError):
     """Step-size underflow or too many steps."""
 
@@ -469,7 +476,7 @@ class _Stepper:
             if adaptive:
                 sc = p.scale(Y, Y1, G0, rtol, atol)
                 err = m.error_norm(K, h_try, sc)
-                factor = 0.9 * (max(err, 1e-10) ** (-1.0 / order))
+                factor = _step_factor(err, order)
                 if err > 1.0:
                     self.n_rejected += 1
                     h = h_try * max(0.2, min(0.9, factor))
@@ -486,7 +493,7 @@ class _Stepper:
                         # Output times inside the step: the continuous extension must meet
                         # the tolerance as well, or the step is retried shorter.
                         err_d = m.interpolant_error(f, interp, sc)
-                        factor_d = 0.9 * (max(err_d, 1e-10) ** (-1.0 / order))
+                        factor_d = _step_factor(err_d, order)
                         if err_d > 1.0:
                             self.n_rejected += 1
                             h = h_try * max(0.2, min(0.9, factor_d))
