@@ -21,6 +21,7 @@ __all__ = [
     "plot_against_nominal",
     "plot_body",
     "plot_components",
+    "plot_kkt",
     "plot_log_lines",
     "plot_panels",
 ]
@@ -217,7 +218,7 @@ def plot_panels(
     )
     for ax, (ylabel, lines) in zip(axes[:, 0], panels, strict=True):
         for label, y, style in lines:
-            ax.plot(t, y, label=label, lw=1.2, **style)
+            ax.plot(t, y, label=label, **{"lw": 1.2, **style})
         ax.set_ylabel(ylabel)
         ax.grid(True, alpha=0.3)
     axes[-1, 0].set_xlabel(t_label)
@@ -373,3 +374,45 @@ def plot_log_lines(
     ax.legend(loc="best", fontsize=8)
     fig.suptitle(title)
     return _save(plt, fig, out, formats)
+
+
+def plot_kkt(
+    kkt: Any,
+    out: Path,
+    formats: Sequence[str] = ("png",),
+    *,
+    title: str | None = None,
+) -> list[Path]:
+    """The KKT conditions of one bound along a trajectory (McCann 2020, Table 6.1; the
+    thesis's Figures 6.6, 6.12, 6.18–6.19): the constraint value g (≤ 0 when feasible), the
+    multiplier μ (≥ 0 when dual feasible) and their product μg (0 under complementary
+    slackness).
+
+    Parameters
+    ----------
+    kkt : gmuk.kkt.InequalityKKT
+    out : Path
+        Output path without suffix.
+    formats : sequence of str
+    title : str, optional
+
+    Returns
+    -------
+    list of Path
+    """
+    unit, mu_unit = kkt.unit or "unit of h", kkt.multiplier_unit
+    zero = {"color": "0.5", "linestyle": ":", "lw": 0.8}
+    panels = [
+        (
+            f"g ({unit})",
+            [("g: primal feasible when ≤ 0", kkt.g, {"color": "C0"}), ("0", 0 * kkt.g, zero)],
+        ),
+        (f"μ ({mu_unit})", [("μ: dual feasible when ≥ 0", kkt.mu, {"color": "C1"})]),
+        (
+            f"μ g ({mu_unit}·{unit})",
+            [("μ g: complementary slackness when 0", kkt.complementarity, {"color": "C2"})],
+        ),
+    ]
+    side = "h ≤ u" if kkt.side == "upper" else "h ≥ l"
+    name = title or f"KKT conditions of {kkt.constraint} ({side}, bound {kkt.bound:g} {unit})"
+    return plot_panels(kkt.t, panels, name, out, formats)

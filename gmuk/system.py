@@ -112,8 +112,11 @@ class System:
         consistency_tol: float = 1e-8,
         rcond: float | None = None,
     ) -> None:
-        self.bodies = tuple(bodies)
         self.constraints = tuple(constraints)
+        # Bodies the constraints bring (an inequality's slack coordinates) come last.
+        owned = [b for c in self.constraints if isinstance(c, Constraint) for b in c.owned_bodies]
+        self.bodies = (*bodies, *owned)
+        self._owned_names = frozenset(b.name for b in owned)
         self.forces = tuple(forces)
         self.controllers = tuple(controllers)
         problems = self._validate()
@@ -227,7 +230,9 @@ class System:
                     f"constraints[{i}] must be a gmuk.Constraint; got {type(c).__name__}"
                 )
             else:
-                check_refs(f"constraint {c.name!r}", c.bodies, c.body_kinds)
+                own = c.owned_bodies
+                refs = [b for b in c.bodies if not any(b is o for o in own)]
+                check_refs(f"constraint {c.name!r}", refs, c.body_kinds)
         for i, f in enumerate(self.forces):
             if not isinstance(f, ForceModel):
                 problems.append(f"forces[{i}] must be a gmuk.ForceModel; got {type(f).__name__}")
@@ -362,7 +367,13 @@ class System:
                     )
         for b in self.bodies:
             for key in need[b.kind]:
-                if b.name not in given[key]:
+                if b.name in self._owned_names:
+                    if b.name in given[key]:
+                        problems.append(
+                            f"{key}[{b.name!r}]: {b.name!r} belongs to a constraint, which sets "
+                            "it from the other bodies' state; do not give it"
+                        )
+                elif b.name not in given[key]:
                     problems.append(f"missing {key}[{b.name!r}]")
         if problems:
             raise DefinitionError(problems)
@@ -375,7 +386,7 @@ class System:
             if b.kind is BodyKind.RIGID:
                 G[sl.index] = check_se3(given["g"][b.name], f"g[{b.name!r}]")
                 Vs[sl.index] = as_array(given["V"][b.name], (6,), f"V[{b.name!r}]", batch=False)
-            else:
+            elif b.name not in self._owned_names:  # owned ones are set below
                 kq, kv = need[b.kind]
                 shape = (sl.dof,)
                 x[sl.index : sl.index + sl.dof] = as_array(
@@ -391,7 +402,21 @@ class System:
         tt = float(t)
         if not np.isfinite(tt):
             raise DefinitionError(f"t must be finite; got {t!r}")
-        return State(tt, G, Vs, x, xd, zz, lay)
+        state = State(tt, G, Vs, x, xd, zz, lay)
+        if self._owned_names:
+            self._set_owned(state)
+        return state
+
+    def _set_owned(self, state: State) -> None:
+        """Fill in the bodies the constraints own (slack coordinates) from the others."""
+        free = self._free(state, self._generalized_forces(state)[0])
+        for c, cols in zip(self.constraints, self._constraint_cols, strict=True):
+            if not c.owned_bodies:
+                continue
+            values = c.initial_owned_state(state, free[cols])
+            for body, (w, w_dot) in zip(c.owned_bodies, values, strict=True):
+                i = self.layout.slot(body).index
+                state.x[i], state.xdot[i] = w, w_dot
 
     # ------------------------------------------------------------------ dynamics
     def _apply_Minv(self, Q: FloatArray) -> FloatArray:

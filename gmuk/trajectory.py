@@ -26,7 +26,7 @@ from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError, FileFormatError
 from gmuk.lie import euler, so3
-from gmuk.state import Layout
+from gmuk.state import Layout, State
 
 __all__ = ["BodyTrajectory", "Trajectory", "load_trajectory"]
 
@@ -117,6 +117,40 @@ class Trajectory:
     def __len__(self) -> int:
         return int(self.t.shape[0])
 
+    def _point_columns(self) -> np.ndarray:
+        lay = self.layout
+        idx = [
+            lay.slot(name).index + np.arange(3)
+            for name, kind in zip(self.body_names, self.body_kinds, strict=True)
+            if kind == BodyKind.POINT
+        ]
+        return np.array(idx, dtype=np.int64).reshape(-1, 3)
+
+    @property
+    def r_N(self) -> FloatArray:
+        """Positions of the point masses, shape (N, n_point, 3), in N (m), in body order."""
+        return self.x[:, self._point_columns()]
+
+    @property
+    def v_N(self) -> FloatArray:
+        """Velocities of the point masses, shape (N, n_point, 3), in N (m/s)."""
+        return self.xdot[:, self._point_columns()]
+
+    def state(self, i: int) -> State:
+        """The State at output ``i`` (a copy; negative indices count from the end)."""
+        n = len(self)
+        if not -n <= i < n:
+            raise DefinitionError(f"output index {i} out of range for {n} outputs")
+        return State(
+            float(self.t[i]),
+            self.g_NB[i].copy(),
+            self.V_B[i].copy(),
+            self.x[i].copy(),
+            self.xdot[i].copy(),
+            self.z[i].copy(),
+            self.layout,
+        )
+
     def body(self, name: str) -> BodyTrajectory:
         """Per-body view (positions, attitudes, rates, wrenches) of body ``name``."""
         if name not in self.body_names:
@@ -125,6 +159,9 @@ class Trajectory:
 
     def save(self, path: str | Path) -> Path:
         """Save to a compressed ``.npz`` (arrays plus JSON metadata); returns the path.
+
+        Besides the attributes, the file holds ``r_N`` and ``v_N`` (N, n_point, 3): the
+        point masses' positions and velocities in body order (``meta["body_kinds"]``).
 
         The file is written atomically: to a temporary file in the same folder, then renamed
         over ``path``, so a run stopped while saving leaves the previous file (or none), never
@@ -143,6 +180,8 @@ class Trajectory:
             "stats": self.stats,
         }
         arrays = {k: getattr(self, k) for k in _ARRAYS}
+        # Convenience copies for readers without gmuk: point masses as (N, n_point, 3).
+        arrays["r_N"], arrays["v_N"] = self.r_N, self.v_N
         with atomic_write(path) as tmp:
             with open(tmp, "wb") as fh:
                 np.savez_compressed(fh, meta=np.array(json.dumps(meta)), **arrays)

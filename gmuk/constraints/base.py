@@ -127,6 +127,22 @@ class Constraint(FreezesInSystem, abc.ABC):
         object.__setattr__(self, "_cached_indices", (state.layout, indices))
         return indices
 
+    @property
+    def owned_bodies(self) -> tuple[Body, ...]:
+        """Bodies this constraint brings with it (e.g. an inequality's slack coordinates);
+        the System adds them after its own bodies. None by default."""
+        return ()
+
+    def initial_owned_state(
+        self, state: State, free_acceleration: FloatArray
+    ) -> list[tuple[float, float]]:
+        """Value and rate of each of :attr:`owned_bodies` consistent with ``state``.
+
+        :meth:`gmuk.System.state` calls it once, with the free acceleration (modeled forces)
+        of this constraint's columns; only constraints that own bodies implement it.
+        """
+        raise NotImplementedError(f"{type(self).__name__} owns no bodies")
+
     @abc.abstractmethod
     def rows(self, state: State) -> tuple[Any, Any]:
         """Rows of the constraint at ``state``.

@@ -80,6 +80,11 @@ def _move(q: FloatArray, kind: str, delta: FloatArray) -> FloatArray:
     return q + delta
 
 
+def _along(q: Config, nu: Config, kinds: tuple[str, ...], tau: float) -> Config:
+    """Every body moved by τ along its velocity: ``q ⊕ τν``."""
+    return tuple(_move(qi, k, tau * vi) for qi, vi, k in zip(q, nu, kinds, strict=True))
+
+
 def _kinds_of(q: Config) -> tuple[str, ...]:
     """Body kinds from configuration shapes: a (4, 4) pose is rigid, anything else Euclidean."""
     return tuple("rigid" if qi.shape == (4, 4) else "euclid" for qi in q)
@@ -149,6 +154,53 @@ class _Differentiable(Constraint):
                 cols.append(_stencil1(f, float(steps[k])))
         return np.stack(cols, axis=-1)
 
+    def _path_fd(
+        self, fun: Callable[[Config, float], Any], q: Config, nu: Config, t: float
+    ) -> tuple[FloatArray, FloatArray]:
+        """First and second derivatives of ``fun(q ⊕ τν, t + τ)`` at τ = 0."""
+        kinds = _kinds_of(q)
+        tau = self._path_step(nu, kinds)
+
+        def h(s: float) -> FloatArray:
+            return np.asarray(fun(_along(q, nu, kinds, s), t + s), dtype=float)
+
+        hm2, hm1, h0, hp1, hp2 = h(-2 * tau), h(-tau), h(0.0), h(tau), h(2 * tau)
+        d1 = (hm2 - 8.0 * hm1 + 8.0 * hp1 - hp2) / (12.0 * tau)
+        d2 = (-hm2 + 16.0 * hm1 - 30.0 * h0 + 16.0 * hp1 - hp2) / (12.0 * tau * tau)
+        return d1, d2
+
+    @staticmethod
+    def _velocity_jacobian_fd(
+        fun: Callable[[Config, Config, float], Any], q: Config, nu: Config, t: float
+    ) -> FloatArray:
+        """∂fun/∂ν by central differences in each velocity component."""
+        cols: list[FloatArray] = []
+        for i, v in enumerate(nu):
+            for k in range(v.size):
+                step = _JAC_STEP * max(1.0, abs(float(v[k])))
+
+                def f(eps: float, i: int = i, k: int = k, v: FloatArray = v) -> FloatArray:
+                    moved = list(nu)
+                    vv = v.copy()
+                    vv[k] += eps
+                    moved[i] = vv
+                    return np.asarray(fun(q, tuple(moved), t), dtype=float)
+
+                cols.append(_stencil1(f, step))
+        return np.stack(cols, axis=-1)
+
+    def _velocity_bias_fd(
+        self, fun: Callable[[Config, Config, float], Any], q: Config, nu: Config, t: float
+    ) -> FloatArray:
+        """−(d/dτ) fun(q ⊕ τν, ν, t + τ) at τ = 0: the rate of ``fun`` with ν held."""
+        kinds = _kinds_of(q)
+        tau = self._path_step(nu, kinds)
+
+        def h(s: float) -> FloatArray:
+            return np.asarray(fun(_along(q, nu, kinds, s), nu, t + s), dtype=float)
+
+        return -_stencil1(h, tau)
+
 
 class HolonomicConstraint(_Differentiable):
     """A holonomic constraint ``φ(q, t) = 0`` given by its residual.
@@ -199,17 +251,7 @@ class HolonomicConstraint(_Differentiable):
         return self._path_derivatives(q, nu, t)[0]
 
     def _path_derivatives(self, q: Config, nu: Config, t: float) -> tuple[FloatArray, FloatArray]:
-        kinds = _kinds_of(q)
-        tau = self._path_step(nu, kinds)
-
-        def h(s: float) -> FloatArray:
-            moved = tuple(_move(qi, k, s * vi) for qi, vi, k in zip(q, nu, kinds, strict=True))
-            return np.asarray(self.residual(moved, t + s), dtype=float)
-
-        hm2, hm1, h0, hp1, hp2 = h(-2 * tau), h(-tau), h(0.0), h(tau), h(2 * tau)
-        d1 = (hm2 - 8.0 * hm1 + 8.0 * hp1 - hp2) / (12.0 * tau)
-        d2 = (-hm2 + 16.0 * hm1 - 30.0 * h0 + 16.0 * hp1 - hp2) / (12.0 * tau * tau)
-        return d1, d2
+        return self._path_fd(lambda qq, tt: self.residual(qq, tt), q, nu, t)
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) at ``state``, with Baumgarte terms when gains are set."""
@@ -244,31 +286,11 @@ class NonholonomicConstraint(_Differentiable):
 
     def jacobian(self, q: Config, nu: Config, t: float) -> FloatArray:
         """A = ∂ψ/∂ν, shape (s, Σ dof). Override for speed."""
-        cols: list[FloatArray] = []
-        for i, v in enumerate(nu):
-            for k in range(v.size):
-                step = _JAC_STEP * max(1.0, abs(float(v[k])))
-
-                def f(eps: float, i: int = i, k: int = k, v: FloatArray = v) -> FloatArray:
-                    moved = list(nu)
-                    vv = v.copy()
-                    vv[k] += eps
-                    moved[i] = vv
-                    return np.asarray(self.residual(q, tuple(moved), t), dtype=float)
-
-                cols.append(_stencil1(f, step))
-        return np.stack(cols, axis=-1)
+        return self._velocity_jacobian_fd(self.residual, q, nu, t)
 
     def bias(self, q: Config, nu: Config, t: float) -> FloatArray:
         """b = −(d/dτ) ψ(q ⊕ τν, ν, t + τ) at τ = 0, shape (s,). Override for speed."""
-        kinds = _kinds_of(q)
-        tau = self._path_step(nu, kinds)
-
-        def h(s: float) -> FloatArray:
-            moved = tuple(_move(qi, k, s * vi) for qi, vi, k in zip(q, nu, kinds, strict=True))
-            return np.asarray(self.residual(moved, nu, t + s), dtype=float)
-
-        return -_stencil1(h, tau)
+        return self._velocity_bias_fd(self.residual, q, nu, t)
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) at ``state``, with the Baumgarte term when a gain is set."""

@@ -16,7 +16,13 @@ if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
     from gmuk.state import State
 
-__all__ = ["AppliedWrench", "SpringDamper", "UniformGravity"]
+__all__ = [
+    "AppliedWrench",
+    "LinearSpringDamper",
+    "SlackDamping",
+    "SpringDamper",
+    "UniformGravity",
+]
 
 STANDARD_GRAVITY = 9.80665  # m/s², CGPM 1901
 
@@ -102,6 +108,95 @@ class UniformGravity(ForceModel):
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
         """m g_N (N)."""
         return body.mass * self.g_N
+
+
+class LinearSpringDamper(ForceModel):
+    """A linear spring and damper from a fixed anchor: ``f_N = −k (r_N − r_a) − c v_N``.
+
+    Isotropic, with zero rest length, so it is defined everywhere (also at the anchor, where
+    :class:`SpringDamper` has no direction). On a rigid body it acts at the centre of mass
+    (no torque); ``v_N = R v_B``. In one dimension this is the spring–mass–damper
+    ``m ẍ + c ẋ + k x = 0`` of McCann (2020) §6.5.1.
+
+    Parameters
+    ----------
+    stiffness : float
+        k (N/m), ≥ 0.
+    damping : float
+        c (N·s/m), ≥ 0.
+    anchor : array_like (3,)
+        r_a in N (m); the origin by default.
+    bodies : sequence of Body or str, optional
+        The bodies it acts on (default: every point mass and rigid body).
+    modeled : bool
+    name : str, optional
+    """
+
+    def __init__(
+        self,
+        stiffness: float,
+        damping: float = 0.0,
+        anchor: Any = (0.0, 0.0, 0.0),
+        *,
+        bodies: Sequence[Body | str] | None = None,
+        modeled: bool = True,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(bodies, modeled=modeled, name=name)
+        for label, v in (("stiffness", stiffness), ("damping", damping)):
+            if not (np.isfinite(v) and v >= 0):
+                raise DefinitionError(f"{label} must be finite and ≥ 0; got {v!r}")
+        self.k, self.c = float(stiffness), float(damping)
+        self.anchor = as_array(anchor, (3,), "anchor", batch=False)
+
+    def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
+        """−k(r_N − r_a) − c v_N (N)."""
+        return -self.k * (r_N - self.anchor) - self.c * v_N
+
+    def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
+        """[0; Rᵀ f_N] at the centre of mass (N·m, N)."""
+        R = g_NB[:3, :3]
+        f_N = -self.k * (g_NB[:3, 3] - self.anchor) - self.c * (R @ V_B[3:])
+        return np.concatenate([np.zeros(3), R.T @ f_N])
+
+
+class SlackDamping(ForceModel):
+    """Viscous damping of slack and excess coordinates, ``f = −c ẇ``: a choice of slack
+    dynamics (McCann 2020, §6.3.3).
+
+    Without it an inequality's slack keeps the energy the bodies hand it when they reach the
+    bound and gives it back: the contact is elastic, and a body pressed onto a bound
+    oscillates off it with an amplitude that decays only like 1/√t. Damping the slack makes
+    the contact inelastic, so the bodies settle on the bound. It acts on the slack
+    coordinates only, never on a physical body.
+
+    Parameters
+    ----------
+    coefficient : float
+        c (kg/s per unit of w, the slack's mass over time), ≥ 0; critical damping of a slack
+        of mass m_w on a bound of stiffness κ (N per unit of w²) is ``2√(2κ m_w)``.
+    bodies : sequence of SlackCoordinate or str, optional
+        Default: every slack coordinate of the System.
+    name : str, optional
+    """
+
+    acts_on = frozenset({BodyKind.SLACK})
+
+    def __init__(
+        self,
+        coefficient: float,
+        *,
+        bodies: Sequence[Body | str] | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(bodies, name=name)
+        if not (np.isfinite(coefficient) and coefficient >= 0):
+            raise DefinitionError(f"coefficient must be finite and ≥ 0; got {coefficient!r}")
+        self.c = float(coefficient)
+
+    def wrenches(self, state: State, bodies: Sequence[Body]) -> list[FloatArray]:
+        """−c ẇ (1,) for each slack coordinate."""
+        return [-self.c * state.velocity(b) for b in bodies]
 
 
 class SpringDamper(ForceModel):

@@ -72,6 +72,9 @@ SCENARIOS: dict[str, str] = {
     "uceim": "gmuk.scenarios.uceim:SCENARIO",
     "fccl": "gmuk.scenarios.fccl:SCENARIO",
     "unmodeled": "gmuk.scenarios.unmodeled:SCENARIO",
+    "smd-gt": "gmuk.scenarios.smd:GT",
+    "smd-lt": "gmuk.scenarios.smd:LT",
+    "smd-bi": "gmuk.scenarios.smd:BI",
 }
 
 #: Entry-point group through which other packages register scenarios.
@@ -104,12 +107,17 @@ class ScenarioResult:
         The key of the trajectory saved as ``trajectory.npz``.
     summary : dict
         Headline figures (JSON-serialisable), with units in the keys.
+    data : dict
+        Further results for the figures and for Python users (e.g. the
+        :class:`gmuk.kkt.KKTDiagnostics` of each run, the Systems); the command line saves
+        only what the scenario's ``write_data`` writes.
     """
 
     name: str
     trajectories: dict[str, Trajectory]
     primary: str
     summary: dict[str, Any] = field(default_factory=dict)
+    data: dict[str, Any] = field(default_factory=dict)
 
 
 FigureFn = Callable[[ScenarioResult, Path, tuple[str, ...]], list[Path]]
