@@ -9,12 +9,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from gmuk._validation import FloatArray
 from gmuk.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from gmuk.kkt import InequalityKKT
 
 __all__ = [
     "compare_body",
@@ -377,7 +380,7 @@ def plot_log_lines(
 
 
 def plot_kkt(
-    kkt: Any,
+    kkt: InequalityKKT,
     out: Path,
     formats: Sequence[str] = ("png",),
     *,
@@ -402,7 +405,7 @@ def plot_kkt(
     """
     unit, mu_unit = kkt.unit or "unit of h", kkt.multiplier_unit
     zero = {"color": "0.5", "linestyle": ":", "lw": 0.8}
-    panels = [
+    panels: list[tuple[str, list[tuple[str, FloatArray, dict[str, Any]]]]] = [
         (
             f"g ({unit})",
             [("g: primal feasible when ≤ 0", kkt.g, {"color": "C0"}), ("0", 0 * kkt.g, zero)],

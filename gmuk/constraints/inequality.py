@@ -540,8 +540,9 @@ class TrackingErrorBound(InequalityConstraint):
     body : Body or str
         A point mass.
     reference : object
-        With ``position(t)``, ``velocity(t)`` and ``acceleration(t)`` returning (3,) arrays
-        in N (m, m/s, m/s²), e.g. a :class:`gmuk.orbits.KeplerOrbit`.
+        With ``kinematics(t)`` returning (r_r, ṙ_r, r̈_r), or ``position(t)``,
+        ``velocity(t)`` and ``acceleration(t)``, each a (3,) array in N (m, m/s, m/s²); e.g.
+        a :class:`gmuk.orbits.KeplerOrbit` (two-body motion).
     bound : float or callable
         δ (m) or γ (m/s), > 0; or a function ``t -> (value, rate, second rate)``.
     quantity : {"position", "velocity"}
@@ -551,6 +552,7 @@ class TrackingErrorBound(InequalityConstraint):
     """
 
     body_kinds: ClassVar[frozenset[BodyKind]] = frozenset({BodyKind.POINT})
+    _ref_cache: tuple[float, tuple[FloatArray, FloatArray, FloatArray]] | None = None
 
     def __init__(
         self,
@@ -571,9 +573,13 @@ class TrackingErrorBound(InequalityConstraint):
             )
         if form not in ("norm", "squared"):
             raise DefinitionError(f"{who}: form must be 'norm' or 'squared'; got {form!r}")
-        for method in ("position", "velocity", "acceleration"):
-            if not callable(getattr(reference, method, None)):
-                raise DefinitionError(f"{who}: reference needs a {method}(t) method")
+        if not callable(getattr(reference, "kinematics", None)):
+            for method in ("position", "velocity", "acceleration"):
+                if not callable(getattr(reference, method, None)):
+                    raise DefinitionError(
+                        f"{who}: reference needs kinematics(t) or position(t), velocity(t) "
+                        f"and acceleration(t); it has no {method}(t)"
+                    )
         base = "m" if quantity == "position" else "m/s"
         super().__init__(
             [body],
@@ -589,10 +595,25 @@ class TrackingErrorBound(InequalityConstraint):
         self.quantity = quantity
         self.form = form
 
+    def reference_kinematics(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """r_r, ṙ_r, r̈_r (N; m, m/s, m/s²) at t, evaluated once per time (the rows ask for
+        them several times at the same t)."""
+        cached = self._ref_cache
+        if cached is not None and cached[0] == t:
+            return cached[1]
+        ref = self.reference
+        if callable(getattr(ref, "kinematics", None)):
+            r, v, a = ref.kinematics(t)
+        else:
+            r, v, a = ref.position(t), ref.velocity(t), ref.acceleration(t)
+        out = tuple(np.asarray(x, dtype=float).reshape(3) for x in (r, v, a))
+        object.__setattr__(self, "_ref_cache", (t, out))
+        return out  # type: ignore[return-value]
+
     def errors(self, q: Config, nu: Config, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
         """e = r − r_r, ė = ṙ − ṙ_r (N) and the reference acceleration r̈_r at t."""
-        ref = self.reference
-        return q[0] - ref.position(t), nu[0] - ref.velocity(t), np.asarray(ref.acceleration(t))
+        r_r, v_r, a_r = self.reference_kinematics(t)
+        return q[0] - r_r, nu[0] - v_r, a_r
 
     def _error_and_bound(self, q: Config, nu: Config, t: float) -> tuple[FloatArray, Any]:
         e, e_dot, _ = self.errors(q, nu, t)

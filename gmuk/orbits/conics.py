@@ -344,6 +344,22 @@ class KeplerOrbit:
         """Two-body acceleration ``−μ r / r³`` in N (m/s²), shape (..., 3)."""
         return self.perifocal_state(t)[2] @ self.R_NP.T
 
+    def kinematics(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Position (m), velocity (m/s) and two-body acceleration (m/s²) in N at one time t
+        (s since periapsis), each of shape (3,): the scalar fast path of :meth:`position`,
+        :meth:`velocity` and :meth:`acceleration` for right-hand sides that need all three."""
+        f = self._scalar_anomaly(float(t))[0]
+        c, s = math.cos(f), math.sin(f)
+        r = self.p / (1.0 + self.e * c)
+        k = math.sqrt(self.mu / self.p)
+        g = -self.mu / (r * r)
+        R = self.R_NP
+        return (
+            R @ np.array([r * c, r * s, 0.0]),
+            R @ np.array([-k * s, k * (self.e + c), 0.0]),
+            R @ np.array([g * c, g * s, 0.0]),
+        )
+
     def state_at_true_anomaly(self, f: Any) -> tuple[FloatArray, FloatArray]:
         """Position (m) and velocity (m/s) in N at true anomalies f (rad), shape (..., 3)."""
         f = as_array(f, (), "f")

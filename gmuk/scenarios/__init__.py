@@ -57,6 +57,7 @@ __all__ = [
     "comma_separated",
     "describe",
     "get",
+    "non_negative_float",
     "positive_float",
     "refresh",
 ]
@@ -75,6 +76,7 @@ SCENARIOS: dict[str, str] = {
     "smd-gt": "gmuk.scenarios.smd:GT",
     "smd-lt": "gmuk.scenarios.smd:LT",
     "smd-bi": "gmuk.scenarios.smd:BI",
+    "maintenance": "gmuk.scenarios.maintenance:SCENARIO",
 }
 
 #: Entry-point group through which other packages register scenarios.
@@ -135,6 +137,17 @@ def positive_float(text: str) -> float:
         value = float("nan")
     if not (value > 0 and value != float("inf")):
         raise ValueError("must be a finite number > 0")
+    return value
+
+
+def non_negative_float(text: str) -> float:
+    """A finite number ≥ 0, e.g. ``"0"`` or ``"1e-8"``."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value >= 0 and value != float("inf")):
+        raise ValueError("must be a finite number >= 0")
     return value
 
 

@@ -102,7 +102,14 @@ from gmuk.constraints.tracking import tracking_errors
 from gmuk.control import MorseLyapunovController
 from gmuk.lie import so3
 from gmuk.orbits import KeplerOrbit, LVLHReference, fcei_orbit
-from gmuk.scenarios import Option, Scenario, ScenarioResult, boolean, positive_float
+from gmuk.scenarios import (
+    Option,
+    Scenario,
+    ScenarioResult,
+    boolean,
+    non_negative_float,
+    positive_float,
+)
 from gmuk.scenarios import _lvlh as common
 from gmuk.trajectory import Trajectory
 
@@ -520,14 +527,6 @@ def run(
         for label, row in rows.items():
             summary |= {f"baumgarte_{label}_{k}": row[k] for k in _BAUMGARTE_KEYS}
     return ScenarioResult(NAME, trajs, NAME, summary)
-
-
-def non_negative_float(text: str) -> float:
-    """A finite number ≥ 0."""
-    value = float(text)
-    if not (np.isfinite(value) and value >= 0):
-        raise ValueError("must be a finite number >= 0")
-    return value
 
 
 # --- figures -----------------------------------------------------------------------------------

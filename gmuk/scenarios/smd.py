@@ -59,7 +59,7 @@ import gmuk
 from gmuk import plotting
 from gmuk._validation import FloatArray
 from gmuk.kkt import KKTDiagnostics, kkt_diagnostics
-from gmuk.scenarios import Option, Scenario, ScenarioResult, positive_float
+from gmuk.scenarios import Option, Scenario, ScenarioResult, non_negative_float, positive_float
 
 MASS = 2.0  # kg
 DAMPING = 5.0  # N·s/m
@@ -74,14 +74,6 @@ CASES: dict[str, tuple[tuple[float | None, float | None], float, float, str, str
     "smd-lt": ((None, 1.0), 0.0, 5.0, "6.7–6.12", "x ≤ 1 m"),
     "smd-bi": ((1.0, 2.0), 1.5, 6.0, "6.13–6.19", "1 m ≤ x ≤ 2 m"),
 }
-
-
-def non_negative_float(text: str) -> float:
-    """A finite number ≥ 0."""
-    value = float(text)
-    if not (0.0 <= value < float("inf")):
-        raise ValueError("must be a finite number ≥ 0")
-    return value
 
 
 def steady_state(case: str) -> tuple[float, float]:
