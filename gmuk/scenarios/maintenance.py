@@ -184,7 +184,7 @@ def run(
     span = orbits * orbit.period
     t_eval = np.linspace(0.0, span, output_count(orbits, PER_ORBIT))
     gamma = velocity_bound if velocity_bound > 0.0 else None
-    runs = {"maintenance": (position_bound, gamma)}
+    runs: dict[str, tuple[float | None, float | None]] = {"maintenance": (position_bound, gamma)}
     if compare:
         if gamma is not None:
             runs["position_only"] = (position_bound, None)
