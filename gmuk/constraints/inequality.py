@@ -619,6 +619,16 @@ class TrackingErrorBound(InequalityConstraint):
         e, e_dot, _ = self.errors(q, nu, t)
         return (e if self.quantity == "position" else e_dot), self.bound(t)
 
+    def _norm(self, err: FloatArray) -> float:
+        n = float(np.linalg.norm(err))
+        if not n > 0.0:
+            raise ConstraintError(
+                f"{self._who()}: the {self.quantity} error is zero, where the norm form "
+                f"(‖error‖ − bound) has no derivative (its rows are not finite); start off "
+                f"the reference, or use form='squared'"
+            )
+        return n
+
     def value(self, q: Config, nu: Config, t: float) -> float:
         """‖error‖ − bound, or ½(‖error‖² − bound²) for the squared form."""
         err, (d, _, _) = self._error_and_bound(q, nu, t)
@@ -630,7 +640,7 @@ class TrackingErrorBound(InequalityConstraint):
         """errorᵀ/‖error‖ (Eqs. 107, 109), or errorᵀ for the squared form."""
         err, _ = self._error_and_bound(q, nu, t)
         if self.form == "norm":
-            return err / np.linalg.norm(err)
+            return err / self._norm(err)
         return err.copy()
 
     def bias(self, q: Config, nu: Config, t: float) -> float:
@@ -639,10 +649,10 @@ class TrackingErrorBound(InequalityConstraint):
         d, d_dot, d_ddot = (float(x) for x in self.bound(t))
         if self.quantity == "velocity":
             if self.form == "norm":
-                return float(a_r @ e_dot) / float(np.linalg.norm(e_dot)) + d_dot
+                return float(a_r @ e_dot) / self._norm(e_dot) + d_dot
             return float(a_r @ e_dot) + d * d_dot
         if self.form == "norm":
-            n = float(np.linalg.norm(e))
+            n = self._norm(e)
             ede = float(e_dot @ e)
             return (float(a_r @ e) - float(e_dot @ e_dot)) / n + ede * ede / n**3 + d_ddot
         return float(a_r @ e) - float(e_dot @ e_dot) + d_dot * d_dot + d * d_ddot
@@ -652,5 +662,5 @@ class TrackingErrorBound(InequalityConstraint):
         e, e_dot, _ = self.errors(q, nu, t)
         d, d_dot, _ = (float(x) for x in self.bound(t))
         if self.form == "norm":
-            return float(e_dot @ e) / float(np.linalg.norm(e)) - d_dot
+            return float(e_dot @ e) / self._norm(e) - d_dot
         return float(e_dot @ e) - d * d_dot
