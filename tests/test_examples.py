@@ -23,6 +23,14 @@ CHECKS = {
     "custom_orbit_tracking.py": lambda r: (
         r["max_position_error_m"] < 1e-5 and r["max_constraint_torque_N_m"] > 0
     ),
+    # touches the floor, never goes through it, rests on it with the normal force = weight,
+    # and the frictionless floor leaves the horizontal speed alone
+    "inequality_floor.py": lambda r: (
+        r["min_height_m"] < 1e-3
+        and r["primal_violation_max_m"] <= 1e-9
+        and abs(r["normal_force_vs_weight"]) < 1e-8
+        and abs(r["final_horizontal_speed_m_s"] - 0.5) < 1e-9
+    ),
     "free_rigid_body.py": lambda r: r["energy_drift"] < 1e-10 and r["orthogonality"] < 1e-13,
     "spherical_pendulum.py": lambda r: r["radius_error_m"] < 1e-8 and r["mean_tension_N"] > 0,
     "virtual_pair.py": lambda r: r["locked_components_max"] < 1e-9 and r["roll_vs_analytic"] < 1e-8,
