@@ -184,3 +184,17 @@ def test_orbit_is_immutable_and_validated():
         orbit.position([0.0, float("nan")])
     with pytest.raises(OrbitError, match="asymptote"):
         ORBITS["hyperbola"].time_from_true_anomaly(3.0)
+
+
+@pytest.mark.parametrize("name", list(ORBITS))
+def test_scalar_kinematics_equal_the_array_position_velocity_and_acceleration(name):
+    orbit = ORBITS[name]
+    for t in sample_times(orbit, 9):
+        r, v, a = orbit.kinematics(float(t))
+        for got, want in (
+            (r, orbit.position(t)),
+            (v, orbit.velocity(t)),
+            (a, orbit.acceleration(t)),
+        ):
+            assert got.shape == (3,)
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-12 * np.linalg.norm(want))
