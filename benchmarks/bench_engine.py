@@ -122,7 +122,6 @@ def breakdown() -> None:
     import timeit
 
     from gmuk import _uk_kernels
-    from gmuk._numba import entry
 
     J = np.diag([3.0e4, 3.2e4, 3.4e4])
     body = gmuk.RigidBody("a", 15103.0, J)
@@ -133,7 +132,7 @@ def breakdown() -> None:
     A, b = S._stack_rows(st, check_finite=False)
     z = S._zero_loads
     args = (st.V, z, A, b, S.solver._params, np.empty(4 * 6 + 6 + 3))
-    compiled = entry(_uk_kernels.uk_rigid_c)
+    compiled = gmuk.solvers._fused_entry()
     parts = [
         ("System.accelerations (whole call)", lambda: S.accelerations(st)),
         ("reference.evaluate (the user's)", lambda: ref.evaluate(0.3)),

@@ -257,7 +257,7 @@ def main() -> None:
     if entry is not None:
         empty_entry = entry(_empty_kernel)
         floor["empty compiled call, compiled entry"] = lambda: empty_entry(d0, r1, buf, True)
-        acc_entry = entry(_kernels.acceleration_at)
+        acc_entry = _kernels.ENTRIES.acceleration_at
         d10 = fields[10]._data
         floor["gmuk's compiled acceleration entry alone, degree 0"] = lambda: acc_entry(
             f0._data, r1, buf, True

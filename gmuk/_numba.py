@@ -48,7 +48,7 @@ from typing import Any
 
 import numba
 
-__all__ = ["cache_plan", "entry", "njit", "user_cache_dir"]
+__all__ = ["LazyEntries", "cache_plan", "compiled_entry", "entry", "njit", "user_cache_dir"]
 
 #: numba's configuration module (its settings are attributes made at run time).
 _config: Any = numba.config
@@ -178,3 +178,36 @@ def entry(kernel: Any) -> Any:
         if callable(fn):
             return fn
     return kernel
+
+
+def compiled_entry(kernel: Any, signature: Any) -> Any:
+    """Compile ``kernel`` (a dispatcher made without a signature) for ``signature`` only — or
+    load it from numba's cache — close it to further compilation, as a signature given to
+    the decorator would, and return its :func:`entry`."""
+    if not kernel.overloads:
+        kernel.compile(signature)
+        kernel.disable_compile()
+    return entry(kernel)
+
+
+class LazyEntries:
+    """Entry points of single-signature kernels, each compiled (or loaded from numba's
+    cache) the first time it is used, not when its module is imported.
+
+    ``LazyEntries(name=(kernel, signature), ...)``; ``entries.name`` is then the compiled
+    entry (:func:`compiled_entry`), kept as an ordinary attribute after the first access.
+    A kernel given a signature in its decorator compiles at import: a process that never
+    calls it (a run without spherical harmonics) would pay for it all the same.
+    """
+
+    def __init__(self, **kernels: tuple[Any, Any]) -> None:
+        self._pending = dict(kernels)
+
+    def __getattr__(self, name: str) -> Any:  # only for names not yet resolved
+        try:
+            kernel, signature = self.__dict__["_pending"][name]
+        except KeyError:
+            raise AttributeError(name) from None
+        fn = compiled_entry(kernel, signature)
+        setattr(self, name, fn)
+        return fn

@@ -363,7 +363,11 @@ def uk_rigid(
     _uk_rigid(V, Q, A, b, P, out)
 
 
-@njit(types.void(_RO2, _RO1, _RO2, _RO1, _RO1, _RW1), cache=True)
+#: The one signature of :func:`uk_rigid_c` (compiled on first use: gmuk._numba.compiled_entry).
+UK_RIGID_C_SIGNATURE = types.void(_RO2, _RO1, _RO2, _RO1, _RO1, _RW1)
+
+
+@njit(cache=True)
 def uk_rigid_c(
     V: np.ndarray, Q: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, out: np.ndarray
 ) -> None:

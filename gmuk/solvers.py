@@ -40,7 +40,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from gmuk import _uk_kernels, uk
-from gmuk._numba import entry
+from gmuk._numba import compiled_entry
 from gmuk._validation import FloatArray, all_finite
 from gmuk.bodies import Body, RigidBody
 from gmuk.constraints.tangent_bundle import TangentBundleConstraint
@@ -77,7 +77,17 @@ QR_COND_LIMIT = 1e8
 _EPS = float(np.finfo(float).eps)
 _F64 = np.dtype(np.float64)
 _empty = np.empty
-_uk_rigid_c = entry(_uk_kernels.uk_rigid_c)
+#: The compiled entry of :func:`gmuk._uk_kernels.uk_rigid_c`, made by :func:`_fused_entry`
+#: when the first System that takes the fused solve is built (not on import).
+_uk_rigid_c: Any = None
+
+
+def _fused_entry() -> Any:
+    """The compiled entry of the fused solve, compiled (or loaded from the cache) once."""
+    global _uk_rigid_c
+    if _uk_rigid_c is None:
+        _uk_rigid_c = compiled_entry(_uk_kernels.uk_rigid_c, _uk_kernels.UK_RIGID_C_SIGNATURE)
+    return _uk_rigid_c
 
 
 @dataclass(frozen=True, eq=False)
@@ -322,6 +332,7 @@ class FusedRigidSolver(DenseSolver):
 
     def __init__(self, system: System) -> None:
         super().__init__(system)
+        _fused_entry()
         lay = system.layout
         self._layout = lay
         self._n = lay.n_dof

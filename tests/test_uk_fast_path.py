@@ -173,7 +173,7 @@ def _values(acc):
 
 def _count_entry_calls(monkeypatch):
     calls = []
-    entry = gmuk.solvers._uk_rigid_c
+    entry = gmuk.solvers._fused_entry()
 
     def counted(*args):
         calls.append(1)

@@ -236,9 +236,9 @@ class InequalityConstraint(_Differentiable):
         """A_h, shape (Σ dof,): ∂h/∂q along body-frame directions (position level) or
         ∂h/∂ν (velocity level). Override for speed."""
         if self.level == "position":
-            fun = lambda qq: np.atleast_1d(self.value(qq, nu, t))  # noqa: E731
+            fun = lambda qq: np.array([self._value(qq, nu, t)])  # noqa: E731
             return self._jacobian_fd(fun, q, _kinds_of(q))[0]
-        fun2 = lambda qq, vv, tt: np.atleast_1d(self.value(qq, vv, tt))  # noqa: E731
+        fun2 = lambda qq, vv, tt: np.array([self._value(qq, vv, tt)])  # noqa: E731
         return self._velocity_jacobian_fd(fun2, q, nu, t)[0]
 
     def bias(self, q: Config, nu: Config, t: float) -> float:
@@ -246,14 +246,14 @@ class InequalityConstraint(_Differentiable):
         the part of the derivative that does not involve the accelerations. Override for
         speed."""
         if self.level == "position":
-            return -float(self._path_fd(lambda qq, tt: self.value(qq, nu, tt), q, nu, t)[1])
-        fun = lambda qq, vv, tt: np.atleast_1d(self.value(qq, vv, tt))  # noqa: E731
+            return -float(self._path_fd(lambda qq, tt: self._value(qq, nu, tt), q, nu, t)[1])
+        fun = lambda qq, vv, tt: np.array([self._value(qq, vv, tt)])  # noqa: E731
         return float(self._velocity_bias_fd(fun, q, nu, t)[0])
 
     def rate(self, q: Config, nu: Config, t: float) -> float:
         """ḣ at the position level (for the initial slack rate and Baumgarte). Override for
         speed."""
-        return float(self._path_fd(lambda qq, tt: self.value(qq, nu, tt), q, nu, t)[0])
+        return float(self._path_fd(lambda qq, tt: self._value(qq, nu, tt), q, nu, t)[0])
 
     # ------------------------------------------------------------------ checked evaluation
     def _who(self) -> str:
@@ -270,6 +270,10 @@ class InequalityConstraint(_Differentiable):
         if not math.isfinite(arr):
             raise ConstraintError(f"{self._who()}: {what} is not finite; got {arr!r}")
         return arr
+
+    def _value(self, q: Config, nu: Config, t: float) -> float:
+        """:meth:`value`, checked to be a finite scalar."""
+        return self._scalar(self.value(q, nu, t), "value()")
 
     def _row(self, q: Config, nu: Config, t: float, n: int) -> FloatArray:
         A_h = np.asarray(self.jacobian(q, nu, t), dtype=float).reshape(-1)
@@ -296,7 +300,7 @@ class InequalityConstraint(_Differentiable):
     def h(self, state: State) -> float:
         """h at ``state`` (checked: a finite scalar)."""
         q, nu = self._configs(state)
-        return self._scalar(self.value(q, nu, state.t), "value()")
+        return self._value(q, nu, state.t)
 
     # ------------------------------------------------------------------ rows
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
@@ -314,7 +318,7 @@ class InequalityConstraint(_Differentiable):
         position = self.level == "position"
         gains = self.baumgarte
         if gains is not None:
-            h = self._scalar(self.value(q, nu, t), "value()")
+            h = self._value(q, nu, t)
             h_dot = self._scalar(self.rate(q, nu, t), "rate()") if position else 0.0
         for i, (bd, j) in enumerate(zip(self._bounds, self._slack_indices(state), strict=True)):
             w, w_dot = float(state.x[j]), float(state.xdot[j])
@@ -364,7 +368,7 @@ class InequalityConstraint(_Differentiable):
         """
         q, nu = self._configs(state)
         t = state.t
-        h = self._scalar(self.value(q, nu, t), "value()")
+        h = self._value(q, nu, t)
         out: list[tuple[float, float]] = []
         position = self.level == "position"
         h_dot = self._scalar(self.rate(q, nu, t), "rate()") if position else 0.0

@@ -66,7 +66,9 @@ Calling without numba's dispatcher
 ----------------------------------
 Numba's dispatcher resolves argument types on every call, which costs more than
 evaluating a low-degree field. :func:`entry` returns the compiled function of a
-single-signature kernel, which skips that resolution; it does not check the arguments
+single-signature kernel, which skips that resolution (:data:`ENTRIES` compiles each on
+first use, so that a process without spherical harmonics never compiles them); it does
+not check the arguments
 beyond their Python type, so callers must pass exactly the declared types (float64, the
 declared number of dimensions, C-contiguous except the single-point position, which may
 have any strides). :mod:`gmuk.gravity.field` does.
@@ -82,10 +84,11 @@ from numba import carray, types, uint64
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gmuk._numba import entry, njit  # entry re-exported: field.py calls kernels through it
+from gmuk._numba import LazyEntries, entry, njit  # entry re-exported for callers
 from gmuk._validation import FloatArray
 
 __all__ = [
+    "ENTRIES",
     "FLAT_WIDTH",
     "HEADER",
     "NOT_ONE_POINT",
@@ -237,7 +240,7 @@ def field_data(mu: float, radius: float, C: FloatArray, S: FloatArray) -> FloatA
     return d
 
 
-@njit(_RW(_RW), cache=True)
+@njit(cache=True)
 def _numba_owned(a):  # type: ignore[no-untyped-def]
     """A copy of ``a`` allocated by numba.
 
@@ -764,10 +767,10 @@ def _workspace(N, mode):  # type: ignore[no-untyped-def]
     return Q, size - 10, flat
 
 
-# One explicit signature: positions typed read-only accept writable arrays as well, so a
-# read-only input never triggers a second compilation. Compiled (or loaded from numba's
-# on-disk cache) when this module is imported.
-@njit(types.int64(_RO, _RO, _RW, _RW2, types.int64), cache=True)
+# One explicit signature each (ENTRIES below): positions typed read-only accept writable
+# arrays as well, so a read-only input never triggers a second compilation. Compiled (or
+# loaded from numba's on-disk cache) on first use, not on import.
+@njit(cache=True)
 def evaluate(d, r, out, hess, mode):  # type: ignore[no-untyped-def]
     """Potential, gradient and/or Hessian of a field at points (see the package docstring).
 
@@ -839,7 +842,7 @@ NOT_ONE_POINT = -1
 # the first import's compilation much longer (benchmarks/README.md, Gravity).
 
 
-@njit(types.int64(_RO, _RA, _RW, types.boolean), cache=True)
+@njit(cache=True)
 def acceleration_at(d, r, out, central):  # type: ignore[no-untyped-def]
     """∇U (m/s²) at the point ``r`` (m), written into ``out`` (3,)."""
     if r.shape[0] != 3:
@@ -857,7 +860,7 @@ def acceleration_at(d, r, out, central):  # type: ignore[no-untyped-def]
     return code
 
 
-@njit(types.int64(_RO, _RA, _RW, _RW2, types.boolean), cache=True)
+@njit(cache=True)
 def acceleration_hessian_at(d, r, out, hess, central):  # type: ignore[no-untyped-def]
     """∇U (m/s²) into ``out`` (3,) and ∇∇U (1/s²) into ``hess`` (3, 3), in one pass."""
     if r.shape[0] != 3:
@@ -884,7 +887,7 @@ def acceleration_hessian_at(d, r, out, hess, central):  # type: ignore[no-untype
     return code
 
 
-@njit(types.int64(_RO, _RA, _RW, types.boolean), cache=True)
+@njit(cache=True)
 def potential_at(d, r, out, central):  # type: ignore[no-untyped-def]
     """U (m²/s²) at the point ``r`` (m), written to ``out[0]``."""
     if r.shape[0] != 3:
@@ -895,3 +898,15 @@ def potential_at(d, r, out, central):  # type: ignore[no-untyped-def]
     if code == OK:
         out[0] = Q[o]
     return code
+
+
+#: The compiled entries of the kernels above (see :class:`gmuk._numba.LazyEntries`).
+ENTRIES = LazyEntries(
+    evaluate=(evaluate, types.int64(_RO, _RO, _RW, _RW2, types.int64)),
+    acceleration_at=(acceleration_at, types.int64(_RO, _RA, _RW, types.boolean)),
+    potential_at=(potential_at, types.int64(_RO, _RA, _RW, types.boolean)),
+    acceleration_hessian_at=(
+        acceleration_hessian_at,
+        types.int64(_RO, _RA, _RW, _RW2, types.boolean),
+    ),
+)

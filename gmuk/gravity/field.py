@@ -25,15 +25,12 @@ from gmuk.gravity import _kernels
 
 __all__ = ["FieldValues", "SphericalHarmonicField"]
 
-#: The compiled kernels, called without numba's type dispatch (see
-#: :func:`gmuk._numba.entry`): every call below passes float64 arrays of the declared
-#: number of dimensions, C-contiguous except the single-point position (positions pass
-#: through :func:`_points`, or are checked to be a float64 vector: the ``*_at`` entries
+#: The compiled kernels, called without numba's type dispatch and compiled on first use
+#: (see :class:`gmuk._numba.LazyEntries`): every call below passes float64 arrays of the
+#: declared number of dimensions, C-contiguous except the single-point position (positions
+#: pass through :func:`_points`, or are checked to be a float64 vector: the ``*_at`` entries
 #: check the length themselves).
-_evaluate = _kernels.entry(_kernels.evaluate)
-_acceleration_at = _kernels.entry(_kernels.acceleration_at)
-_potential_at = _kernels.entry(_kernels.potential_at)
-_acceleration_hessian_at = _kernels.entry(_kernels.acceleration_hessian_at)
+_kernel = _kernels.ENTRIES
 
 # mode bits of the kernel
 _POT = 1
@@ -413,7 +410,7 @@ class SphericalHarmonicField:
         """
         if _is_vector(r_F):  # fast path: one point
             out = _empty(1)
-            code = _potential_at(self._data, r_F, out, central)
+            code = _kernel.potential_at(self._data, r_F, out, central)
             if not code:
                 return float(out[0])
             if code > 0:
@@ -450,7 +447,7 @@ class SphericalHarmonicField:
             one = False
         if one:
             out = _empty(3)
-            code = _acceleration_at(self._data, r_F, out, central)
+            code = _kernel.acceleration_at(self._data, r_F, out, central)
             if not code:
                 return out
             if code > 0:
@@ -478,7 +475,9 @@ class SphericalHarmonicField:
             r = _points(r_F)
         if r.dtype is _F64 and r.shape == _SHAPE3:
             H = np.empty((3, 3))
-            code = _evaluate(self._data, r, _NO_OUT, H, _HES if central else _HES | _NO_CENTRAL)
+            code = _kernel.evaluate(
+                self._data, r, _NO_OUT, H, _HES if central else _HES | _NO_CENTRAL
+            )
             if code:
                 raise self._failure(code, r)
             return H
@@ -514,7 +513,7 @@ class SphericalHarmonicField:
         if one:
             a = _empty(3)
             H = _empty(_SHAPE33)
-            code = _acceleration_hessian_at(self._data, r_F, a, H, central)
+            code = _kernel.acceleration_hessian_at(self._data, r_F, a, H, central)
             if not code:
                 return a, H
             if code > 0:
@@ -569,7 +568,7 @@ class SphericalHarmonicField:
         if r.dtype is _F64 and r.shape == _SHAPE3:
             out = np.empty(_STRIDE[mode])
             H = np.empty((3, 3)) if mode & _HES else _NO_HESS
-            code = _evaluate(self._data, r, out, H, mode if central else mode | _NO_CENTRAL)
+            code = _kernel.evaluate(self._data, r, out, H, mode if central else mode | _NO_CENTRAL)
             if code:
                 raise self._failure(code, r)
             pot = float(out[0]) if mode & _POT else None
@@ -588,7 +587,9 @@ class SphericalHarmonicField:
         out = np.empty(k * stride)
         H = np.empty((3 * k, 3)) if mode & _HES else _NO_HESS
         if k:
-            code = _evaluate(self._data, flat, out, H, mode if central else mode | _NO_CENTRAL)
+            code = _kernel.evaluate(
+                self._data, flat, out, H, mode if central else mode | _NO_CENTRAL
+            )
             if code:
                 raise self._failure(code, flat.reshape(k, 3))
         table = out.reshape(k, stride)

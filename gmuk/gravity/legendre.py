@@ -31,7 +31,6 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import types
 
 from gmuk._numba import njit
 from gmuk._validation import FloatArray
@@ -41,7 +40,7 @@ from gmuk.gravity._kernels import BIG, BIGI
 __all__ = ["legendre_4pi", "normalization_4pi"]
 
 
-@njit(types.void(types.int64, types.float64, types.float64[:, ::1]), cache=True)
+@njit(cache=True)
 def _legendre_columns(nmax, t, out):  # type: ignore[no-untyped-def]
     """Fill out[n, m] = P̄_nm(t) for 0 ≤ m ≤ n ≤ nmax (out zeroed by the caller)."""
     u = math.sqrt((1.0 - t) * (1.0 + t))
