@@ -300,6 +300,8 @@ class System:
                 bs = [self._resolve(r) for r in f.bodies]
             self._force_bodies.append(bs)
         self._ctrl_bodies = [[self._resolve(r) for r in c.bodies] for c in self.controllers]
+        # The CSR pattern of the stacked rows when every constraint gives dense blocks.
+        self._csr_pattern: tuple[Any, np.ndarray, np.ndarray, np.ndarray | None] | None = None
         offs = np.cumsum([0] + [c.n_states for c in self.controllers])
         self._ctrl_slices = [slice(int(a), int(b)) for a, b in itertools.pairwise(offs)]
 
@@ -551,6 +553,8 @@ class System:
         if self.sparse:
             if not blocks:
                 return sp.csr_matrix((0, n)), b
+            if all(type(Ai) is np.ndarray for Ai, _, _ in blocks):
+                return self._csr_from_dense(blocks, s), b
             rows, cols_all, data = [], [], []
             r0 = 0
             for Ai, bi, cols in blocks:
@@ -572,6 +576,48 @@ class System:
             A[r0 : r0 + bi.size, where] = Ai.toarray() if sp.issparse(Ai) else Ai
             r0 += bi.size
         return A, b
+
+    def _csr_from_dense(
+        self, blocks: list[tuple[Any, FloatArray, np.ndarray]], s: int
+    ) -> sp.csr_matrix:
+        """The stacked A (s, n_dof) in CSR from dense blocks, by a pattern made once.
+
+        The pattern (column indices, row pointers and the order that sorts each block's
+        columns) depends only on the blocks' shapes; it is built on the first call and again
+        only when a shape changes. Each call then concatenates the blocks' values: no sparse
+        matrix per constraint. Entries that are zero in a block are kept as stored zeros.
+        """
+        shapes = tuple(Ai.shape for Ai, _, _ in blocks)
+        pattern = self._csr_pattern
+        if pattern is None or pattern[0] != shapes:
+            pattern = self._make_csr_pattern(shapes, [cols for _, _, cols in blocks])
+            self._csr_pattern = pattern
+        _, indices, indptr, gather = pattern
+        data = np.concatenate([Ai.ravel() for Ai, _, _ in blocks])
+        if gather is not None:
+            data = data[gather]
+        # copies: scipy may sort or prune a matrix's index arrays in place
+        return sp.csr_matrix(
+            (data, indices.copy(), indptr.copy()), shape=(s, self.layout.n_dof), copy=False
+        )
+
+    @staticmethod
+    def _make_csr_pattern(
+        shapes: tuple[tuple[int, ...], ...], columns: list[np.ndarray]
+    ) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray | None]:
+        indices, gather, counts = [], [], []
+        base = 0
+        for (rows, width), cols in zip(shapes, columns, strict=True):
+            order = np.argsort(cols, kind="stable")
+            indices.append(np.tile(cols[order], rows))
+            gather.append(base + (np.arange(rows)[:, None] * width + order[None, :]).ravel())
+            counts.append(np.full(rows, width))
+            base += rows * width
+        index = np.concatenate(indices).astype(np.int32)
+        take = np.concatenate(gather)
+        indptr = np.concatenate([[0], np.cumsum(np.concatenate(counts))]).astype(np.int32)
+        identity = bool(np.array_equal(take, np.arange(take.size)))
+        return shapes, index, indptr, None if identity else take
 
     def accelerations(self, state: State) -> Accelerations:
         """Free, constraint and total accelerations at ``state``, with multipliers.
