@@ -96,7 +96,7 @@ class InequalityKKT:
 
     def summary(self) -> dict[str, float]:
         """Maxima over the outputs: primal violation (unit of h), dual violation (unit of μ),
-        |μ g| (JSON-serialisable)."""
+        and the largest abs(μ g) (JSON-serialisable)."""
         return {
             "primal_violation_max": float(self.primal_violation.max(initial=0.0)),
             "dual_violation_max": float(self.dual_violation.max(initial=0.0)),

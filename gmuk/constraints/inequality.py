@@ -136,9 +136,12 @@ class InequalityConstraint(_Differentiable):
         Whether h depends on the configurations and time only ("position", Eqs. 95/97) or
         also on the velocities ("velocity": the slack enters as ẇ², as in Eq. 102).
     slack_mass : float
-        Mass of each slack coordinate in Gauss's function (kg per unit of w², where
-        w² has the unit of h). It sets how the constraint force is shared between the
-        bodies and the slack: smaller makes the contact with the bound more abrupt.
+        Gauss's weight m_w of each slack coordinate (w² has the unit of h, so m_w is in
+        kg·m² per unit of h at the position level — kg·m for a bound in metres — and in
+        kg·m²/s² per unit of h at the velocity level — kg·m/s for a bound in m/s). It sets
+        how the constraint force is shared between the bodies and the slack: the bodies get
+        half of it at the margin ``m_w A_h M⁻¹ A_hᵀ / 4`` from the bound (in the unit of h),
+        so a smaller m_w makes the contact with the bound thinner and more abrupt.
     baumgarte : Baumgarte, optional
         Stabilisation of each equality ``φ = h − bound + σw² = 0`` (α, β for the position
         level; α only for the velocity level). Off by default.
@@ -357,6 +360,11 @@ class InequalityConstraint(_Differentiable):
         is the KKT one: ``ẇ = √(−σḧ_free / 2)`` when the free motion moves inside (no force),
         0 when it presses outward (the bound holds). Velocity level: ``ẇ = √(σ(bound − h))``,
         ``w = 0``.
+
+        A bound held from the start (w = ẇ = 0) stays held for the rest of the run, even if
+        the forces later pull the bodies inside (then μ < 0): ``w = ẇ = 0`` is invariant. Near
+        it a bound releases slowly (w grows like exp(λt) with λ = √(2|μ|/m_w)); start inside
+        the bound by a margin if the forces may reverse.
 
         Raises
         ------

@@ -167,14 +167,16 @@ class SlackDamping(ForceModel):
     Without it an inequality's slack keeps the energy the bodies hand it when they reach the
     bound and gives it back: the contact is elastic, and a body pressed onto a bound
     oscillates off it with an amplitude that decays only like 1/√t. Damping the slack makes
-    the contact inelastic, so the bodies settle on the bound. It acts on the slack
-    coordinates only, never on a physical body.
+    the contact inelastic, so the bodies settle on the bound. The force is applied to the
+    slack coordinates only, but the bodies feel it through the equality that ties them to
+    the slack (away from the bound too).
 
     Parameters
     ----------
     coefficient : float
-        c (kg/s per unit of w, the slack's mass over time), ≥ 0; critical damping of a slack
-        of mass m_w on a bound of stiffness κ (N per unit of w²) is ``2√(2κ m_w)``.
+        c, ≥ 0, in the unit of the slack mass per second (kg·m/s for a position bound in
+        metres). A slack of mass m_w at a bound held with multiplier μ obeys
+        ``m_w ẅ = −2μw − cẇ`` (stiffness 2μ), so ``c = 2√(2μ m_w)`` damps it critically.
     bodies : sequence of SlackCoordinate or str, optional
         Default: every slack coordinate of the System.
     name : str, optional

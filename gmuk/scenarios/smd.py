@@ -9,12 +9,12 @@ origin, kept by a :class:`gmuk.PlaneBound` on x:
 scenario    inequality      coordinates         initial state (chosen here)
 ==========  ==============  ==================  =======================================
 ``smd-gt``  x ≥ 5 m         excess p            x₀ = 8 m, ẋ₀ = 0 (released above)
-``smd-lt``  x ≤ 1 m         slack s             x₀ = 0, ẋ₀ = 5 m/s (would reach 1.30 m)
+``smd-lt``  x ≤ 1 m         slack s             x₀ = 0, ẋ₀ = 5 m/s (would reach 1.16 m)
 ``smd-bi``  1 m ≤ x ≤ 2 m   slack s, excess p   x₀ = 1.5 m, ẋ₀ = 6 m/s (hits 2 m, then 1 m)
 ==========  ==============  ==================  =======================================
 
 The thesis does not print its initial conditions; these make every bound active during the
-run. The slack coordinates have mass 1 (kg per m, Gauss's weight of the slack), their initial
+run. The slack coordinates have mass 1 kg·m (Gauss's weight of the slack), their initial
 values come from the state (``p₀ = √(x₀ − 5)``, ``ṗ₀ = ẋ₀/(2p₀)``, …), and each equality
 ``x − bound ± w² = 0`` has Baumgarte gains α = 10 s⁻¹, β = 25 s⁻² so that its drift stays
 at round-off. Thirty seconds (the span of the thesis's Figure 6.20), DOP853 at rtol = 1e-10,
@@ -31,13 +31,14 @@ damper, whose rate ``b ẋ² = 4b w² ẇ²`` vanishes at the bound, removes it.
 amplitude decays like t^(−1/2), so x − bound like 1/t. ``--slack-damping C`` adds a damper
 ``−C ẇ`` on the slack coordinates (:class:`gmuk.SlackDamping`, a choice of slack dynamics the
 thesis leaves open in §6.3.3): the contact becomes inelastic and the steady state is reached
-exponentially (C = 20 kg/s is critical at the GT bound).
+exponentially (C = 20 kg·m/s is critical at the GT bound, where μ = 50 N).
 
 Figures
 -------
 Per run (thesis Figures 6.1–6.6, 6.7–6.12, 6.13–6.19): position with the constraint value
 x ∓ w², velocity, control acceleration (the constraint force over m), control effort
-∫|u| dt, the multipliers λ, and the KKT conditions of each bound (:func:`gmuk.kkt.kkt_diagnostics`).
+∫ abs(u) dt, the multipliers λ, and the KKT conditions of each bound
+(:func:`gmuk.kkt.kkt_diagnostics`).
 
 Command line
 ------------
@@ -126,7 +127,7 @@ def control_acceleration(traj: gmuk.Trajectory) -> FloatArray:
 
 
 def control_effort(traj: gmuk.Trajectory) -> FloatArray:
-    """∫₀ᵗ |u| dt (m/s), trapezoidal over the outputs."""
+    """∫₀ᵗ abs(u) dt (m/s), trapezoidal over the outputs."""
     u = np.abs(control_acceleration(traj))
     steps = 0.5 * (u[1:] + u[:-1]) * np.diff(traj.t)
     return np.concatenate([[0.0], np.cumsum(steps)])
@@ -227,12 +228,12 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
 
 _OPTIONS = (
     Option("duration", positive_float, 30.0, "simulated time (s)"),
-    Option("slack_mass", positive_float, 1.0, "mass of each slack coordinate (kg/m)"),
+    Option("slack_mass", positive_float, 1.0, "Gauss's weight of each slack coordinate (kg·m)"),
     Option(
         "slack_damping",
         non_negative_float,
         0.0,
-        "viscous damping of the slack coordinates (kg/s); 0 is the thesis's formulation",
+        "viscous damping of the slack coordinates (kg·m/s); 0 is the thesis's formulation",
     ),
 )
 
