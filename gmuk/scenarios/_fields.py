@@ -12,10 +12,18 @@ from gmuk import gravity
 from gmuk.errors import DefinitionError
 from gmuk.gravity import MOON_MU, SphericalHarmonicField, load_gfc
 
-__all__ = ["DEFAULT_FIELD", "lunar_field"]
+__all__ = ["DEFAULT_FIELD", "harmonic_degree", "lunar_field"]
 
 #: The field scenarios use unless told otherwise (shipped with gmuk, to degree 150).
 DEFAULT_FIELD = "GRGM660PRIM"
+
+
+def harmonic_degree(text: str) -> int:
+    """A ``--degree`` option: an integer ≥ 2 (the lowest degree with harmonics)."""
+    value = int(text)
+    if value < 2:
+        raise ValueError("must be an integer >= 2")
+    return value
 
 
 def lunar_field(field: Any, who: str) -> tuple[SphericalHarmonicField, str]:

@@ -77,7 +77,7 @@ from gmuk.scenarios import (
     non_negative_float,
     positive_float,
 )
-from gmuk.scenarios._fields import DEFAULT_FIELD, lunar_field
+from gmuk.scenarios._fields import DEFAULT_FIELD, harmonic_degree, lunar_field
 from gmuk.scenarios._lvlh import output_count
 
 NAME = "maintenance"
@@ -159,13 +159,6 @@ def control_effort(traj: gmuk.Trajectory) -> FloatArray:
     """∫₀ᵗ ‖u‖ dt (m/s), trapezoidal over the outputs."""
     u = np.linalg.norm(control_acceleration(traj), axis=1)
     return np.concatenate([[0.0], np.cumsum(0.5 * (u[1:] + u[:-1]) * np.diff(traj.t))])
-
-
-def _degree(text: str) -> int:
-    value = int(text)
-    if value < 2:
-        raise ValueError("must be an integer >= 2")
-    return value
 
 
 def run(
@@ -387,7 +380,7 @@ SCENARIO = Scenario(
             GAMMA,
             "γ, the velocity-error bound (m/s); 0 leaves it out (the thesis's formulation)",
         ),
-        Option("degree", _degree, DEGREE, "degree of the lunar field the spacecraft feels"),
+        Option("degree", harmonic_degree, DEGREE, "degree of the lunar field the spacecraft feels"),
         Option(
             "field",
             str,

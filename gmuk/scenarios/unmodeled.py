@@ -82,7 +82,7 @@ from gmuk.gravity import SphericalHarmonicField
 from gmuk.orbits import LVLHReference, fcei_orbit
 from gmuk.scenarios import Option, Scenario, ScenarioResult, boolean, fccl, positive_float
 from gmuk.scenarios import _lvlh as common
-from gmuk.scenarios._fields import DEFAULT_FIELD, lunar_field
+from gmuk.scenarios._fields import DEFAULT_FIELD, harmonic_degree, lunar_field
 from gmuk.trajectory import Trajectory
 
 if TYPE_CHECKING:
@@ -444,13 +444,6 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
     return paths
 
 
-def _degree(text: str) -> int:
-    value = int(text)
-    if value < 2:
-        raise ValueError("must be an integer >= 2")
-    return value
-
-
 SCENARIO = Scenario(
     NAME,
     DESCRIPTION,
@@ -465,7 +458,9 @@ SCENARIO = Scenario(
             "lunar gravity field: the name of a field shipped with gmuk (GRGM660PRIM, to "
             "degree 150) or the path of an ICGEM .gfc file",
         ),
-        Option("degree", _degree, DEGREE, "highest degree of the unmodeled harmonics (>= 2)"),
+        Option(
+            "degree", harmonic_degree, DEGREE, "highest degree of the unmodeled harmonics (>= 2)"
+        ),
         Option("robust", boolean, True, "Eq. 90's robust term in the controller"),
         Option(
             "k_integral",
