@@ -25,8 +25,8 @@ from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
 from gmuk.celestial import CelestialBody
 from gmuk.errors import DefinitionError
+from gmuk.forces import _kernels
 from gmuk.forces.base import ForceModel
-from gmuk.lie import so3
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
@@ -100,18 +100,11 @@ class GravityGradient(ForceModel):
         self.mu = _check_mu(mu)
 
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
-        """[L_G; f_G] in the body frame (N·m, N)."""
-        m = body.mass
-        r_N = g_NB[:3, 3]
-        J = body.inertia
-        r_B = g_NB[:3, :3].T @ r_N
-        r2 = float(r_B @ r_B)
-        rn = np.sqrt(r2)
-        Jr = J @ r_B
-        L = (3.0 * self.mu / (r2 * r2 * rn)) * so3._cross(r_B, Jr)
-        shape = Jr + 0.5 * (np.trace(J) - 5.0 * float(r_B @ Jr) / r2) * r_B
-        f = (-self.mu * m / (r2 * rn)) * (r_B + (3.0 / (m * r2)) * shape)
-        return np.concatenate([L, f])
+        """[L_G; f_G] in the body frame (N·m, N); compiled
+        (:func:`gmuk.forces._kernels.gravity_gradient_wrench`)."""
+        out = np.empty(6)
+        _kernels.gravity_gradient_wrench(g_NB, self.mu, body.mass, body.inertia, out)
+        return out
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
         """The point-mass force ``−μ m r_N/|r_N|³`` on a particle (N)."""

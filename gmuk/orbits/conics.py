@@ -23,7 +23,7 @@ import numpy as np
 
 from gmuk._validation import FloatArray, as_array
 from gmuk.errors import OrbitError
-from gmuk.orbits import kepler
+from gmuk.orbits import _kernels, kepler
 from gmuk.orbits.elements import (
     R_NP,
     _check_nu,
@@ -375,15 +375,8 @@ class KeplerOrbit:
     # ------------------------------------------------------------------ scalar fast path
 
     def _scalar_anomaly(self, t: float) -> tuple[float, float, float]:
-        """(f, ḟ, f̈) for one float t, without numpy (the reference's hot path)."""
-        M = self.mean_motion * t
-        e = self.e
-        if e < 1.0:
-            f = kepler.true_from_eccentric_scalar(kepler.eccentric_from_mean_scalar(M, e), e)
-        elif e == 1.0:
-            f = 2.0 * math.atan(kepler.parabolic_from_mean_scalar(M))
-        else:
-            f = kepler.true_from_hyperbolic_scalar(kepler.hyperbolic_from_mean_scalar(M, e), e)
-        k2 = self.mu / self.p**3
-        w = 1.0 + e * math.cos(f)
-        return f, math.sqrt(k2) * w * w, -2.0 * k2 * w**3 * e * math.sin(f)
+        """(f, ḟ, f̈) for one float t, compiled (the reference's hot path)."""
+        out: tuple[float, float, float] = _kernels.anomaly_rates(
+            float(t), self.mean_motion, self.e, self.mu, self.p
+        )
+        return out

@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from gmuk._numba import njit
 from gmuk._validation import FloatArray, as_array
 from gmuk.errors import OrbitError
 
@@ -660,11 +661,13 @@ def hyperbolic_from_true(f: Any, e: Any) -> FloatArray:
 
 
 # ---------------------------------------------------------------- scalar fast paths
-# The same algorithms on Python floats (no validation, no arrays): a reference trajectory is
-# evaluated at every integrator stage, where numpy's per-call overhead would dominate.
-# Callers validate e once; tests check these agree with the vectorised functions.
+# The same algorithms on floats (no validation, no arrays), compiled: a reference trajectory
+# is evaluated at every integrator stage, where numpy's per-call overhead would dominate, and
+# compiled reference kernels call them. Callers validate e once; tests check these agree with
+# the vectorised functions. Pass floats (an int argument compiles a second version).
 
 
+@njit(cache=True)
 def _x_minus_sin_scalar(x: float) -> float:
     if abs(x) >= 1.0:
         return x - math.sin(x)
@@ -675,6 +678,7 @@ def _x_minus_sin_scalar(x: float) -> float:
     return x * x2 * s
 
 
+@njit(cache=True)
 def _sinh_minus_x_scalar(x: float) -> float:
     if abs(x) >= 1.0:
         return math.sinh(x) - x
@@ -685,18 +689,20 @@ def _sinh_minus_x_scalar(x: float) -> float:
     return x * x2 * s
 
 
+@njit(cache=True)
 def _cubic_root_scalar(c1: float, c3: float, x: float) -> float:
     q = math.sqrt(c1 / (3.0 * c3))
     return 2.0 * q * math.sinh(math.asinh(x / (2.0 * c1 * q)) / 3.0)
 
 
+@njit(cache=True)
 def eccentric_from_mean_scalar(M: float, e: float) -> float:
     """:func:`eccentric_from_mean` for one finite float M and ``0 ≤ e < 1`` (not checked)."""
     k = float(round(M / _TWO_PI))
     if abs(k) < _MAX_REVS:
         Mr = ((M - k * _C1) - k * _C2) - k * _C3
-    else:
-        Mr = math.remainder(M, _TWO_PI)
+    else:  # beyond 2²⁶ revolutions a plain remainder is as good as anything (as _reduce)
+        Mr = (M + math.pi) % _TWO_PI - math.pi
         k = (M - Mr) / _TWO_PI
     x = abs(Mr)
     one_m_e = 1.0 - e
@@ -716,6 +722,7 @@ def eccentric_from_mean_scalar(M: float, e: float) -> float:
     return ((Er + k * _C3) + k * _C2) + k * _C1
 
 
+@njit(cache=True)
 def true_from_eccentric_scalar(E: float, e: float) -> float:
     """:func:`true_from_eccentric` for floats (e not checked)."""
     w = math.atan2(
@@ -724,15 +731,12 @@ def true_from_eccentric_scalar(E: float, e: float) -> float:
     return w + _TWO_PI * round((E - w) / _TWO_PI)
 
 
+@njit(cache=True)
 def hyperbolic_from_mean_scalar(M: float, e: float) -> float:
     """:func:`hyperbolic_from_mean` for one finite float and ``e > 1`` (not checked)."""
     x = abs(M)
     em1 = e - 1.0
-    try:
-        H = math.asinh(x / em1)
-    except OverflowError:  # pragma: no cover - x/em1 beyond float range
-        H = math.inf
-    H = min(H, _cubic_root_scalar(em1, e / 6.0, x))
+    H = min(math.asinh(x / em1), _cubic_root_scalar(em1, e / 6.0, x))  # x/em1 may be inf
     for _ in range(2):
         H = math.asinh((x + H) / e)
     for _ in range(_MAX_ITER):
@@ -747,11 +751,13 @@ def hyperbolic_from_mean_scalar(M: float, e: float) -> float:
     return math.copysign(H, M)
 
 
+@njit(cache=True)
 def true_from_hyperbolic_scalar(H: float, e: float) -> float:
     """:func:`true_from_hyperbolic` for floats (e not checked)."""
     return 2.0 * math.atan(math.sqrt((e + 1.0) / (e - 1.0)) * math.tanh(0.5 * H))
 
 
+@njit(cache=True)
 def parabolic_from_mean_scalar(M_p: float) -> float:
     """:func:`parabolic_from_mean` for one finite float."""
     x = abs(M_p)

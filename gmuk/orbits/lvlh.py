@@ -54,6 +54,7 @@ import numpy as np
 from gmuk._validation import FloatArray, as_array, check_se3
 from gmuk.errors import NonFiniteError
 from gmuk.lie import se3
+from gmuk.orbits import _kernels
 from gmuk.orbits.conics import KeplerOrbit
 from gmuk.reference import ReferenceState, ReferenceTrajectory
 
@@ -254,19 +255,8 @@ class LVLHReference(ReferenceTrajectory):
         if not math.isfinite(t):
             raise NonFiniteError(f"t must be finite; got {t!r}")
         o = self._orbit
-        f, fd, fdd = o._scalar_anomaly(t)
-        c, s = math.cos(f), math.sin(f)
-        w = 1.0 + o.e * c
-        r = o.p / w
-        k = math.sqrt(o.mu / o.p)
-        v1, v2 = -k * o.e * s, -k * w
-        R = self._R_NP
-        g = np.empty((4, 4))
-        g[:3, :3] = R @ np.array([[-c, s, 0.0], [-s, -c, 0.0], [0.0, 0.0, 1.0]])
-        g[:3, 3] = R @ np.array([r * c, r * s, 0.0])
-        g[3] = (0.0, 0.0, 0.0, 1.0)
-        V = np.array([0.0, 0.0, fd, v1, v2, 0.0])
-        V_dot = np.array([0.0, 0.0, fdd, o.mu / (r * r) + fd * v2, -fd * v1, 0.0])
+        g, V, V_dot = np.empty((4, 4)), np.empty(6), np.empty(6)
+        _kernels.lvlh_state(t, o.mean_motion, o.e, o.mu, o.p, self._R_NP, g, V, V_dot)
         for x in (g, V, V_dot):  # shared with the next caller at the same time: read-only
             x.flags.writeable = False
         out = ReferenceState(g, V, V_dot)
