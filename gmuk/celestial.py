@@ -57,6 +57,10 @@ class UniformRotation:
 
     def R_NF(self, t: Any) -> FloatArray:
         """Rotation taking F components to N components, shape (3, 3) or (k, 3, 3)."""
+        if type(t) is float:  # one time (the integrator's hot path): no array arithmetic
+            eta_f = self.angle0 + self.rate * t
+            c1, s1 = math.cos(eta_f), math.sin(eta_f)
+            return np.array(((c1, -s1, 0.0), (s1, c1, 0.0), (0.0, 0.0, 1.0)))
         eta = np.asarray(self.angle(t))
         c, s = np.cos(eta), np.sin(eta)
         R = np.zeros((*eta.shape, 3, 3))
@@ -67,6 +71,10 @@ class UniformRotation:
 
     def R_FN(self, t: Any) -> FloatArray:
         """Rotation taking N components to F components (Eq. 61's R_FN)."""
+        if type(t) is float:
+            eta_f = self.angle0 + self.rate * t
+            c1, s1 = math.cos(eta_f), math.sin(eta_f)
+            return np.array(((c1, s1, 0.0), (-s1, c1, 0.0), (0.0, 0.0, 1.0)))
         return np.swapaxes(self.R_NF(t), -1, -2)
 
 

@@ -80,6 +80,9 @@ _empty = np.empty
 #: The compiled entry of :func:`gmuk._uk_kernels.uk_rigid_c`, made by :func:`_fused_entry`
 #: when the first System that takes the fused solve is built (not on import).
 _uk_rigid_c: Any = None
+#: The multipliers of a System without constraints (shared, read-only).
+_NO_MULTIPLIERS = np.zeros(0)
+_NO_MULTIPLIERS.setflags(write=False)
 
 
 def _fused_entry() -> Any:
@@ -292,9 +295,12 @@ class DenseSolver(UKSolver):
     def __init__(self, system: System) -> None:
         super().__init__(system)
         self._Minv_sqrt = system._Minv_sqrt
+        self._unconstrained = not system.constraints
 
     def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:
         """QR or SVD solve of the stacked dense rows."""
+        if self._unconstrained and rows is None:  # nothing to stack or solve
+            return np.zeros_like(a), _NO_MULTIPLIERS, 0, 0.0, 0.0
         A, b = self._rows(state, rows)
         ac, lam, rank, residual = self.solve_rows(state, a, A, b)
         return ac, lam, rank, residual, 0.0

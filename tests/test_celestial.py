@@ -58,3 +58,15 @@ def test_bad_constants_are_reported_together():
 
 def test_celestial_body_is_exported_at_top_level():
     assert gmuk.CelestialBody is CelestialBody
+
+
+def test_one_time_and_many_times_give_the_same_rotation():
+    rot = UniformRotation(2.6617e-6, 0.3)
+    times = np.linspace(-1e7, 1e7, 101)
+    many_NF, many_FN = rot.R_NF(times), rot.R_FN(times)
+    for k, t in enumerate(times):
+        one_NF, one_FN = rot.R_NF(float(t)), rot.R_FN(float(t))
+        assert one_NF.shape == one_FN.shape == (3, 3)
+        np.testing.assert_allclose(one_NF, many_NF[k], rtol=0, atol=4e-16)
+        np.testing.assert_array_equal(one_FN, one_NF.T)
+        np.testing.assert_allclose(one_FN, many_FN[k], rtol=0, atol=4e-16)
