@@ -229,7 +229,7 @@ class UKSolver(abc.ABC):
             extra = system._apply_Minv(unmodeled + control)
             total = total + extra
         else:
-            extra = np.zeros_like(a)
+            extra = np.zeros(a.shape[0])
         return Accelerations(
             system.layout,
             a,

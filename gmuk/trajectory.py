@@ -14,6 +14,8 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+import zipfile
+import zlib
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
@@ -30,7 +32,9 @@ from gmuk.state import Layout, State
 
 __all__ = ["BodyTrajectory", "Trajectory", "load_trajectory"]
 
-_FORMAT_VERSION = 1
+#: The version of the ``.npz`` format :meth:`Trajectory.save` writes. 2 added the ``r_N`` and
+#: ``v_N`` copies of the point masses' states; :func:`load_trajectory` reads 1 and 2.
+FORMAT_VERSION = 2
 _ARRAYS = (
     "t",
     "g_NB",
@@ -171,7 +175,7 @@ class Trajectory:
         if path.suffix != ".npz":
             path = path.with_suffix(path.suffix + ".npz")
         meta = {
-            "format_version": _FORMAT_VERSION,
+            "format_version": FORMAT_VERSION,
             "body_names": list(self.body_names),
             "body_kinds": list(self.body_kinds),
             "body_dofs": list(self.body_dofs),
@@ -333,33 +337,92 @@ def write_text_atomic(path: str | Path, text: str) -> Path:
 def load_trajectory(path: str | Path) -> Trajectory:
     """Load a trajectory saved by :meth:`Trajectory.save`.
 
+    Reads every format version up to this gmuk's (:data:`FORMAT_VERSION`; version 1 files,
+    written before the ``r_N``/``v_N`` copies, load the same) and refuses newer ones.
+
     Raises
     ------
     FileFormatError
-        If the file is not a gmuk trajectory or is missing arrays.
+        If the path is not a readable file, the file is not a gmuk trajectory (not an
+        ``.npz``, truncated or corrupted, missing or inconsistent arrays or metadata), or it
+        was written by a newer gmuk (its format version is above this one's).
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise FileFormatError(f"load_trajectory: path must be a str or os.PathLike; got {path!r}")
     path = Path(path)
+    if not path.is_file():
+        raise FileFormatError(
+            f"{path}: {'not a regular file' if path.exists() else 'no such file'}"
+        )
     try:
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
-            arrays = {k: data[k] for k in _ARRAYS}
+            if not isinstance(meta, dict):
+                raise FileFormatError(f"{path}: metadata is not a JSON object")
+            version = meta.get("format_version")
+            if not isinstance(version, int) or version < 1:
+                raise FileFormatError(
+                    f"{path}: format_version must be a positive integer; got {version!r}"
+                )
+            if version > FORMAT_VERSION:
+                raise FileFormatError(
+                    f"{path}: trajectory format version {version} was written by a newer gmuk; "
+                    f"this one reads versions up to {FORMAT_VERSION}: upgrade gmuk"
+                )
+            arrays: dict[str, Any] = {k: np.asarray(data[k]) for k in _ARRAYS}
+    except FileFormatError:
+        raise
     except KeyError as exc:
         raise FileFormatError(f"{path}: not a gmuk trajectory (missing {exc})") from None
-    except (OSError, ValueError) as exc:
-        raise FileFormatError(f"{path}: cannot read as a gmuk trajectory .npz: {exc}") from None
-    if meta.get("format_version") != _FORMAT_VERSION:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
         raise FileFormatError(
-            f"{path}: trajectory format version {meta.get('format_version')}"
-            f" is not supported (expected {_FORMAT_VERSION})"
-        )
+            f"{path}: cannot read as a gmuk trajectory .npz (truncated or corrupted?): "
+            f"{type(exc).__name__}: {exc}"
+        ) from None
     names = {f.name for f in fields(Trajectory)}
     kw = {k: v for k, v in meta.items() if k in names}
-    return Trajectory(
-        **arrays,
-        **{
-            **kw,
-            "body_names": tuple(meta["body_names"]),
-            "body_kinds": tuple(meta["body_kinds"]),
-            "body_dofs": tuple(meta["body_dofs"]),
-        },
-    )
+    try:
+        body = {
+            "body_names": tuple(str(n) for n in meta["body_names"]),
+            "body_kinds": tuple(str(k) for k in meta["body_kinds"]),
+            "body_dofs": tuple(int(d) for d in meta["body_dofs"]),
+        }
+        traj = Trajectory(**arrays, **{**kw, **body})
+        _check_consistent(traj, path)
+    except FileFormatError:
+        raise
+    except (KeyError, TypeError, ValueError) as exc:
+        raise FileFormatError(
+            f"{path}: inconsistent trajectory metadata or arrays: {type(exc).__name__}: {exc}"
+        ) from None
+    return traj
+
+
+def _check_consistent(traj: Trajectory, path: Path) -> None:
+    """The arrays' shapes agree with the bodies and with each other (a file edited by hand
+    or by another program is refused rather than misread)."""
+    lay = traj.layout
+    n = traj.t.shape[0] if traj.t.ndim == 1 else -1
+    expected = {
+        "t": (n,),
+        "g_NB": (n, lay.n_rigid, 4, 4),
+        "V_B": (n, lay.n_rigid, 6),
+        "x": (n, lay.n_euclid),
+        "xdot": (n, lay.n_euclid),
+        "z": (n, lay.n_control),
+        "acceleration": (n, lay.n_dof),
+        "constraint_acceleration": (n, lay.n_dof),
+        "constraint_force": (n, lay.n_dof),
+        "control_force": (n, lay.n_dof),
+        "unmodeled_force": (n, lay.n_dof),
+        "residual": (n,),
+        "rank": (n,),
+    }
+    for name, shape in expected.items():
+        got = getattr(traj, name).shape
+        if got != shape:
+            raise FileFormatError(
+                f"{path}: array {name!r} has shape {got}; the metadata say {shape}"
+            )
+    if traj.multipliers.ndim != 2 or traj.multipliers.shape[0] != n:
+        raise FileFormatError(f"{path}: array 'multipliers' has shape {traj.multipliers.shape}")

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import json
+import re
+
 import numpy as np
 import pytest
 
 import gmuk
 from gmuk.errors import FileFormatError
 from gmuk.lie import euler
+from gmuk.trajectory import FORMAT_VERSION
 
 
 @pytest.fixture(scope="module")
@@ -99,3 +103,71 @@ def test_save_adds_the_npz_suffix_and_writes_no_temporary_file(traj, tmp_path):
     assert path.name == "run.npz"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.npz"]
     assert np.array_equal(gmuk.load_trajectory(path).t, traj.t)
+
+
+def _rewrite(src, dst, *, meta_change=None, drop=(), replace=None):
+    """A copy of the .npz ``src`` with its metadata edited, arrays dropped or replaced."""
+    with np.load(src, allow_pickle=False) as data:
+        arrays = {k: data[k] for k in data.files if k not in drop}
+    meta = json.loads(str(arrays["meta"]))
+    if meta_change:
+        meta_change(meta)
+    arrays["meta"] = np.array(json.dumps(meta))
+    arrays.update(replace or {})
+    np.savez_compressed(dst, **arrays)
+    return dst
+
+
+def test_older_format_versions_load_and_newer_ones_are_refused(traj, tmp_path):
+    path = traj.save(tmp_path / "run.npz")
+    assert json.loads(str(np.load(path)["meta"]))["format_version"] == FORMAT_VERSION == 2
+
+    def version(v):
+        return lambda meta: meta.update(format_version=v)
+
+    # version 1: written before the r_N / v_N copies
+    v1 = _rewrite(path, tmp_path / "v1.npz", meta_change=version(1), drop=("r_N", "v_N"))
+    back = gmuk.load_trajectory(v1)
+    np.testing.assert_array_equal(back.r_N, traj.r_N)
+    newer = _rewrite(path, tmp_path / "v3.npz", meta_change=version(3))
+    with pytest.raises(FileFormatError, match="format version 3 was written by a newer gmuk"):
+        gmuk.load_trajectory(newer)
+    for bad in (0, "2", None, 1.5):
+        odd = _rewrite(path, tmp_path / "odd.npz", meta_change=version(bad))
+        with pytest.raises(FileFormatError, match="format_version must be a positive integer"):
+            gmuk.load_trajectory(odd)
+
+
+def test_corrupted_truncated_or_edited_files_are_format_errors(traj, tmp_path):
+    path = traj.save(tmp_path / "run.npz")
+    raw = path.read_bytes()
+    cases = {
+        "truncated": raw[: len(raw) // 2],
+        "empty": b"",
+        "flipped": raw[:200] + bytes(b ^ 0xFF for b in raw[200:400]) + raw[400:],
+    }
+    for name, content in cases.items():
+        p = tmp_path / f"{name}.npz"
+        p.write_bytes(content)
+        with pytest.raises(FileFormatError, match=re.escape(str(p))):
+            gmuk.load_trajectory(p)
+    edits = {
+        "no body names": dict(meta_change=lambda m: m.pop("body_names")),
+        "wrong body dofs": dict(meta_change=lambda m: m.update(body_dofs=[6, 4])),
+        "meta not an object": dict(meta_change=lambda m: m.clear()),
+        "short array": dict(replace={"V_B": np.zeros((3, 1, 6))}),
+        "missing array": dict(drop=("residual",)),
+    }
+    for name, how in edits.items():
+        p = _rewrite(path, tmp_path / "edited.npz", **how)
+        with pytest.raises(
+            FileFormatError, match=re.escape(str(p))
+        ):  # every message names the file
+            gmuk.load_trajectory(p)
+        assert name
+    with pytest.raises(FileFormatError, match="no such file"):
+        gmuk.load_trajectory(tmp_path / "absent.npz")
+    with pytest.raises(FileFormatError, match="not a regular file"):
+        gmuk.load_trajectory(tmp_path)
+    with pytest.raises(FileFormatError, match=r"path must be a str or os\.PathLike"):
+        gmuk.load_trajectory(None)

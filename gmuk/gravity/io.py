@@ -96,7 +96,7 @@ def load_gfc(path: str | os.PathLike[str], *, degree: int | None = None) -> Sphe
     >>> moon.name, moon.degree, moon.mu, moon.radius
     ('GRGM660PRIM', 50, 4902799806931.69, 1738000.0)
     """
-    p = Path(path)
+    p = _file(path, "load_gfc")
     lines = _read_lines(p)
     header: dict[str, tuple[str, int]] = {}
     end_line = 0
@@ -164,6 +164,14 @@ def load_gfc(path: str | os.PathLike[str], *, degree: int | None = None) -> Sphe
                 f"{', '.join(repr(e) for e in _ERRORS_WITH_SIGMAS)}; got {err!r}"
             )
     _check_degree_request(degree, nmax, p, "max_degree")
+    _check_size(
+        p,
+        header["max_degree"][1],
+        "max_degree",
+        nmax,
+        nmax,
+        sum(1 for no, line in lines if no > end_line and line.strip()),
+    )
     store = _Store(p, nmax, nmax)
     data_lines = ((no, line) for no, line in lines if no > end_line)
     for no, line in data_lines:
@@ -248,7 +256,7 @@ def load_shadr(
     DegreeError
         ``degree`` above the file's degree.
     """
-    p = Path(path)
+    p = _file(path, "load_shadr")
     lines = [(no, line) for no, line in _read_lines(p) if line.strip()]
     if not lines:
         raise FileFormatError(f"{p}: line 1: empty file; expected a SHADR header record")
@@ -286,6 +294,7 @@ def load_shadr(
             f"(unnormalized); got {state}"
         )
     _check_degree_request(degree, nmax, p, "degree")
+    _check_size(p, no, "degree", nmax, mmax, len(lines) - 1)
     store = _Store(p, nmax, mmax)
     ncols: int | None = None
     for no, line in lines[1:]:
@@ -396,6 +405,41 @@ class _Store:
         if sigmas:
             return self.C, self.S, self.sC, self.sS
         return self.C, self.S, None, None
+
+
+def _file(path: Any, who: str) -> Path:
+    """``path`` as a Path to an existing regular file, or a clear error."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise FileFormatError(f"{who}: path must be a str or os.PathLike; got {path!r}")
+    p = Path(path)
+    if not p.exists():
+        raise FileFormatError(f"{p}: no such file")
+    if not p.is_file():
+        raise FileFormatError(f"{p}: not a regular file (a directory?)")
+    return p
+
+
+#: Up to this many bytes of coefficient arrays are allocated before the lines are read (a
+#: truncated file then gets the reader's precise message naming the first missing term).
+_SMALL_ALLOCATION = 64 * 2**20
+
+
+def _check_size(path: Path, no: int, key: str, nmax: int, mmax: int, lines: int) -> None:
+    """Refuse a header degree the file's own lines cannot fill, before allocating for it
+    (5 arrays of (nmax + 1)² floats): a complete field of degree nmax (order ≤ mmax) has one
+    line per coefficient of degrees 2..nmax (degrees 0 and 1 may be left out)."""
+    if 5 * 8 * (nmax + 1) ** 2 <= _SMALL_ALLOCATION:
+        return
+    full = min(nmax, mmax)
+    # Σ_{n=2}^{nmax} (min(n, mmax) + 1), in closed form (a hostile header may say 1e18)
+    up_to_full = (full + 1) * (full + 2) // 2 - 3 if full >= 2 else 0
+    needed = up_to_full + max(0, nmax - max(full, 1)) * (mmax + 1)
+    if lines < needed:
+        raise FileFormatError(
+            f"{path}: line {no}: the header's {key} {nmax} needs at least {needed} coefficient "
+            f"lines (degrees 2..{nmax}); the file has {lines}: a wrong header or a truncated "
+            "file"
+        )
 
 
 def _read_lines(path: Path) -> list[tuple[int, str]]:

@@ -43,8 +43,28 @@ def test_degree_on_reading_and_path_types(grail):
     np.testing.assert_array_equal(f.C, grail.C[:21, :21])
     with pytest.raises(DegreeError, match="asked for degree 151, but the file's max_degree is 150"):
         load_gfc(GRAIL_FILE, degree=151)
-    with pytest.raises(FileNotFoundError):
+    with pytest.raises(FileFormatError, match=r"nope\.gfc: no such file"):
         load_gfc(GRAIL_FILE.with_name("nope.gfc"))
+    with pytest.raises(FileFormatError, match="not a regular file"):
+        load_gfc(GRAIL_FILE.parent)
+    with pytest.raises(FileFormatError, match=r"path must be a str or os\.PathLike; got None"):
+        load_gfc(None)
+
+
+@pytest.mark.parametrize("reader", ["gfc", "shadr"])
+def test_a_header_degree_the_file_cannot_fill_is_refused_before_allocating(tmp_path, reader):
+    # A hostile header (degree 1e6 would ask for 5 arrays of 8 TB); the file has 3 lines.
+    if reader == "gfc":
+        p = tmp_path / "huge.gfc"
+        head = HEADER.replace("max_degree     3", "max_degree     1000000")
+        p.write_text(head + "gfc 2 0 1e-4 0\ngfc 2 1 0 0\ngfc 2 2 0 0\n")
+        load = load_gfc
+    else:
+        p = tmp_path / "huge.tab"
+        p.write_text("1738.0, 4902.8, 0.0, 1000000, 1000000, 1, 0.0, 0.0\n2, 0, 1e-4, 0\n")
+        load = load_shadr
+    with pytest.raises(FileFormatError, match="needs at least 500001499998 coefficient lines"):
+        load(p)
 
 
 def test_truncated_copy_of_the_real_file(tmp_path):
