@@ -132,3 +132,50 @@ def check_se3(g: Any, name: str = "g", tol: float = GROUP_TOL) -> FloatArray:
             f"rotation block of {name}", tol, err, flat[k, :3, :3], g.shape[:-2], k
         )
     return g
+
+
+def real_number(
+    value: Any,
+    name: str,
+    *,
+    positive: bool = False,
+    non_negative: bool = False,
+    allow_inf: bool = False,
+    error: type[Exception] | None = None,
+) -> float:
+    """``value`` as a float, refusing what is not a real number (bool, complex, str, arrays
+    of more than one element, None) and, as asked, non-finite, negative or zero values.
+
+    Raises ``error`` (default :class:`gmuk.errors.DefinitionError`) naming ``name``, what
+    was expected and what came in.
+    """
+    from gmuk.errors import DefinitionError
+
+    exc = error or DefinitionError
+    kind = "a number > 0" if positive else "a number >= 0" if non_negative else "a real number"
+    bad = isinstance(value, (bool, np.bool_, complex, np.complexfloating, str, bytes))
+    try:
+        v = float(value) if not bad and np.ndim(value) == 0 else float("nan")
+    except (TypeError, ValueError):
+        v, bad = float("nan"), True
+    if bad or v != v:
+        raise exc(f"{name} must be {kind}; got {value!r}")
+    if (v in (float("inf"), float("-inf"))) and not allow_inf:
+        raise exc(f"{name} must be finite; got {value!r}")
+    if (positive and not v > 0) or (non_negative and not v >= 0):
+        raise exc(f"{name} must be {kind}; got {value!r}")
+    return v
+
+
+def check_sequence(value: Any, name: str) -> tuple[Any, ...]:
+    """``value`` as a tuple, refusing None, strings and other non-sequences with a clear
+    :class:`gmuk.errors.DefinitionError`."""
+    from collections.abc import Sequence
+
+    from gmuk.errors import DefinitionError
+
+    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
+        raise DefinitionError(
+            f"{name} must be a sequence (list or tuple); got {type(value).__name__} {value!r:.60}"
+        )
+    return tuple(value)

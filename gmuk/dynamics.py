@@ -66,13 +66,14 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
     if asym > INERTIA_TOL * scale:
         problems.append(f"inertia must be symmetric; got max|J − Jᵀ| = {asym:.3g} kg·m²")
     else:
-        moments = np.linalg.eigvalsh(0.5 * (Jm + Jm.T))
+        # eigenvalues of J / scale, then scaled back: no overflow for entries near 1e308
+        moments = np.linalg.eigvalsh(0.5 * (Jm / scale + Jm.T / scale)) * scale
         if moments[0] <= 0.0:
             problems.append(
                 f"inertia must be positive definite; got principal moments "
                 f"{np.array2string(moments, precision=6)} kg·m²"
             )
-        elif moments[0] + moments[1] < moments[2] * (1.0 - INERTIA_TOL):
+        elif moments[0] / scale + moments[1] / scale < moments[2] / scale * (1.0 - INERTIA_TOL):
             problems.append(
                 f"principal moments must satisfy the triangle inequality J₁ + J₂ ≥ J₃; got "
                 f"{np.array2string(moments, precision=6)} kg·m² "

@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, real_number
 from gmuk.errors import DefinitionError, GmukError, GmukWarning, SimulationError
 
 # The method classes and the registry, re-exported here for convenience.
@@ -324,12 +324,21 @@ def simulate(
     m = get_method(method)
     if on_failure not in ("raise", "return"):
         raise DefinitionError(f"on_failure must be 'raise' or 'return'; got {on_failure!r}")
-    t0, t1 = (float(v) for v in t_span)
-    if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
+    if not isinstance(state0, State):
+        raise DefinitionError(
+            f"state0 must be a gmuk.State (from System.state); got {type(state0).__name__}"
+        )
+    if isinstance(t_span, (str, bytes)) or np.ndim(t_span) != 1 or len(t_span) != 2:
+        raise DefinitionError(f"t_span must be a pair (start, end) in s; got {t_span!r:.60}")
+    t0, t1 = (real_number(v, "t_span") for v in t_span)
+    if not t1 > t0:
         raise DefinitionError(f"t_span must be finite with end > start; got {t_span!r}")
     if state0.layout != system.layout:
         raise DefinitionError("state0 belongs to another System (layouts differ)")
-    outs = None if t_eval is None else np.asarray(t_eval, dtype=float).reshape(-1)
+    try:
+        outs = None if t_eval is None else np.asarray(t_eval, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise DefinitionError(f"t_eval must be an array of times (s); got {t_eval!r:.60}") from None
     if outs is not None and (
         outs.size == 0
         or np.any(np.diff(outs) <= 0)
@@ -338,12 +347,23 @@ def simulate(
         or not np.isfinite(outs).all()
     ):
         raise DefinitionError(f"t_eval must be strictly increasing within t_span {t_span}")
-    if not m.adaptive and not (step is not None and step > 0):
+    if not m.adaptive and step is None:
         raise DefinitionError(
             f"method {label(m)!r} has a fixed step and needs a positive step (step=...)"
         )
-    if not (rtol > 0 and atol > 0):
-        raise DefinitionError(f"rtol and atol must be > 0; got {rtol}, {atol}")
+    if step is not None:
+        step = real_number(step, "step", positive=True)
+    rtol = real_number(rtol, "rtol", positive=True)
+    atol = real_number(atol, "atol", positive=True)
+    if first_step is not None:
+        first_step = real_number(first_step, "first_step", positive=True)
+    max_step = real_number(max_step, "max_step", positive=True, allow_inf=True)
+    if isinstance(max_steps, (bool, np.bool_)) or not isinstance(max_steps, (int, np.integer)):
+        raise DefinitionError(f"max_steps must be an integer >= 1; got {max_steps!r}")
+    if max_steps < 1:
+        raise DefinitionError(f"max_steps must be an integer >= 1; got {max_steps!r}")
+    if progress is not None and not isinstance(progress, (bool, np.bool_)):
+        raise DefinitionError(f"progress must be True, False or None; got {progress!r}")
 
     prob = _Problem(system)
     rec = _Recorder(prob)

@@ -22,11 +22,11 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from gmuk import _uk_kernels, solvers, uk
-from gmuk._validation import FloatArray, as_array, check_se3
+from gmuk._validation import FloatArray, as_array, check_se3, check_sequence, real_number
 from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
 from gmuk.control.base import Controller
-from gmuk.errors import DefinitionError
+from gmuk.errors import ConstraintError, DefinitionError
 from gmuk.forces.base import ForceModel
 from gmuk.integrate import simulate as _simulate
 from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
@@ -112,7 +112,10 @@ class System:
         consistency_tol: float = 1e-8,
         rcond: float | None = None,
     ) -> None:
-        self.constraints = tuple(constraints)
+        bodies = check_sequence(bodies, "bodies")
+        self.constraints = check_sequence(constraints, "constraints")
+        forces = check_sequence(forces, "forces")
+        controllers = check_sequence(controllers, "controllers")
         # Bodies the constraints bring (an inequality's slack coordinates) come last.
         owned = [b for c in self.constraints if isinstance(c, Constraint) for b in c.owned_bodies]
         self.bodies = (*bodies, *owned)
@@ -140,8 +143,14 @@ class System:
         ]
         for part in parts:
             part._freeze()
+        if not isinstance(strict, (bool, np.bool_)):
+            raise DefinitionError(f"strict must be True or False; got {strict!r}")
         self.strict = bool(strict)
-        self.consistency_tol = float(consistency_tol)
+        self.consistency_tol = real_number(consistency_tol, "consistency_tol", positive=True)
+        if rcond is not None:
+            rcond = real_number(rcond, "rcond", positive=True)
+            if not rcond < 1.0:
+                raise DefinitionError(f"rcond must be in (0, 1) or None; got {rcond!r}")
         self.rcond = rcond
         n_ctrl = sum(c.n_states for c in self.controllers)
         self.layout = Layout(
@@ -342,14 +351,14 @@ class System:
         """
         lay = self.layout
         problems: list[str] = []
-        given = {
-            "g": dict(g or {}),
-            "V": dict(V or {}),
-            "r": dict(r or {}),
-            "v": dict(v or {}),
-            "s": dict(s or {}),
-            "s_dot": dict(s_dot or {}),
-        }
+        given: dict[str, dict[Any, Any]] = {}
+        for key, mapping in (("g", g), ("V", V), ("r", r), ("v", v), ("s", s), ("s_dot", s_dot)):
+            if mapping is not None and not isinstance(mapping, Mapping):
+                raise DefinitionError(
+                    f"{key} must be a mapping of body name to value (a dict); got "
+                    f"{type(mapping).__name__} {mapping!r:.60}"
+                )
+            given[key] = dict(mapping or {})
         need = {
             BodyKind.RIGID: ("g", "V"),
             BodyKind.POINT: ("r", "v"),
@@ -401,9 +410,7 @@ class System:
             zz = np.concatenate([c.initial_state() for c in self.controllers] or [np.zeros(0)])
         else:
             zz = as_array(np.reshape(z, -1), (lay.n_control,), "z", batch=False)
-        tt = float(t)
-        if not np.isfinite(tt):
-            raise DefinitionError(f"t must be finite; got {t!r}")
+        tt = real_number(t, "t")
         state = State(tt, G, Vs, x, xd, zz, lay)
         if self._owned_names:
             self._set_owned(state)
@@ -521,7 +528,7 @@ class System:
         :meth:`constraint_rows` names the culprit)."""
         if self._single_dense and not check_finite:
             # The common small case: one dense constraint on every dof, in order.
-            Ai, bi = self.constraints[0].rows(state)
+            Ai, bi = _pair(self.constraints[0], state)
             if (
                 type(Ai) is np.ndarray
                 and type(bi) is np.ndarray
@@ -535,7 +542,7 @@ class System:
             return (Ai.toarray() if sp.issparse(Ai) else Ai), bi
         blocks = []
         for c, cols in zip(self.constraints, self._constraint_cols, strict=True):
-            Ai, bi = c.rows(state)
+            Ai, bi = _pair(c, state)
             if not (
                 not check_finite
                 and type(Ai) is np.ndarray
@@ -651,3 +658,16 @@ class System:
             f"forces={len(self.forces)}, controllers={len(self.controllers)}, "
             f"solver={self.solver.name!r})"
         )
+
+
+def _pair(c: Constraint, state: State) -> tuple[Any, Any]:
+    """A constraint's ``rows(state)``, checked to be a pair (A, b)."""
+    out = c.rows(state)
+    if type(out) is tuple and len(out) == 2:
+        return out
+    if isinstance(out, (tuple, list)) and len(out) == 2:
+        return out[0], out[1]
+    raise ConstraintError(
+        f"constraint {c.name!r}: rows() must return a pair (A, b); got {type(out).__name__}"
+        + (f" of length {len(out)}" if isinstance(out, (tuple, list)) else f" {out!r:.60}")
+    )

@@ -163,18 +163,24 @@ def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[Any, FloatArray]:
 
     A may be dense (array_like) or a scipy.sparse matrix (kept sparse, as CSR).
     """
-    if type(A) is np.ndarray and A.dtype == np.float64 and A.ndim == 2:
-        finite_A = bool(np.isfinite(A).all())
-    elif sp.issparse(A):
-        A = sp.csr_matrix(A, dtype=float)
-        finite_A = bool(np.isfinite(A.data).all())
-    else:
-        A = np.asarray(A, dtype=float)
-        if A.ndim == 1:
-            A = A[None, :]
-        finite_A = bool(np.isfinite(A).all())
-    if type(b) is not np.ndarray or b.dtype != np.float64:
-        b = np.asarray(b, dtype=float)
+    try:
+        if type(A) is np.ndarray and A.dtype == np.float64 and A.ndim == 2:
+            finite_A = bool(np.isfinite(A).all())
+        elif sp.issparse(A):
+            A = sp.csr_matrix(A, dtype=float)
+            finite_A = bool(np.isfinite(A.data).all())
+        else:
+            A = _real_array(A)
+            if A.ndim == 1:
+                A = A[None, :]
+            finite_A = bool(np.isfinite(A).all())
+        if type(b) is not np.ndarray or b.dtype != np.float64:
+            b = _real_array(b)
+    except (TypeError, ValueError) as exc:
+        raise ConstraintError(
+            f"{who}: rows() must return A (s, {n_cols}) and b (s,) as arrays of real numbers; "
+            f"got A {type(A).__name__}, b {type(b).__name__} ({exc})"
+        ) from None
     if b.ndim == 0:
         b = b[None]
     if A.ndim != 2 or A.shape[1] != n_cols or b.shape != (A.shape[0],):
@@ -185,3 +191,11 @@ def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[Any, FloatArray]:
     if not (finite_A and np.isfinite(b).all()):
         raise ConstraintError(f"{who}: rows() returned NaN or inf in A or b")
     return A, b
+
+
+def _real_array(x: Any) -> FloatArray:
+    """``x`` as a float64 array; complex, string or object data is a ValueError."""
+    arr = np.asarray(x)
+    if arr.dtype.kind not in "biuf":
+        raise ValueError(f"dtype {arr.dtype} is not real")
+    return arr.astype(float, copy=False)

@@ -36,7 +36,7 @@ _GIMBAL_TOL = 1e-14
 
 
 def _check_seq(seq: str) -> None:
-    if seq not in SEQUENCES:
+    if not isinstance(seq, str) or seq not in SEQUENCES:
         raise EulerSequenceError(f"seq must be one of {SEQUENCES}; got {seq!r}")
 
 
