@@ -2,7 +2,8 @@
 
     gmuk list
     gmuk plugins
-    gmuk run [NAME] [--out DIR] [--no-plots] [--format png,pdf] [scenario options]
+    gmuk run [NAME] [--out DIR] [--no-plots] [--format FMT] [--checkpoint-every S] [options]
+    gmuk run [NAME] --resume DIR
     gmuk run NAME --help
     gmuk check [--seed S] [--samples N] [--verbose]
 
@@ -14,6 +15,13 @@ flags after NAME are the common ones above and the options the scenario declares
 options not given take the scenario's defaults. A bad value stops with a message naming the
 flag and what came in, exit status 2.
 
+Stopping and resuming (:mod:`gmuk.runs`): SIGINT (Ctrl-C) or SIGTERM stop the run at the next
+integration step; the trajectory so far and ``summary.json`` (``status``, the signal, the time
+reached) are written and the exit status is 130 or 143. Every simulation writes a checkpoint
+into ``DIR/.checkpoints`` every ``--checkpoint-every`` seconds (default 60), so a killed
+process (SIGKILL, a power cut) loses at most one interval; ``gmuk run --resume DIR`` continues
+the run with the options it was started with. A run that completes removes its checkpoints.
+
 ``gmuk check`` prints the table of :func:`gmuk.check <gmuk.crosscheck.check>` and exits 0 if
 every quantity agrees with Pinocchio within its tolerance, 1 if any does not.
 """
@@ -22,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shutil
 import signal
 import sys
 import threading
@@ -30,9 +39,11 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
+from typing import Any
 
-from gmuk import scenarios
+from gmuk import runs, scenarios
 from gmuk.errors import GmukError
+from gmuk.runs import RunControl
 from gmuk.scenarios import OptionError, Scenario
 from gmuk.trajectory import write_text_atomic
 
@@ -89,6 +100,22 @@ def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
     )
     common.add_argument("--no-plots", action="store_true", help="write data only")
     common.add_argument(
+        "--checkpoint-every",
+        type=scenarios.non_negative_float,
+        default=60.0,
+        metavar="SECONDS",
+        help="write a checkpoint of each simulation this often (wall time, s) into "
+        "DIR/.checkpoints, so that a killed run loses at most one interval; 0: never "
+        "(default: 60)",
+    )
+    common.add_argument(
+        "--resume",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="continue the run stopped or killed in DIR, with the options it was started with",
+    )
+    common.add_argument(
         "--format",
         default="png",
         metavar="FMT[,FMT]",
@@ -113,15 +140,17 @@ EXIT_STATUS = {signal.SIGINT: 130, signal.SIGTERM: 143}
 
 
 @contextmanager
-def _stopping_signals() -> Iterator[list[int]]:
-    """SIGTERM handled as Ctrl-C (SIGINT) is: as a KeyboardInterrupt, on which the integrator
-    returns the trajectory so far. Yields the list of the signals received (main thread only;
-    elsewhere the handlers cannot be set and the list stays empty)."""
+def _stopping_signals(control: RunControl) -> Iterator[list[int]]:
+    """SIGINT and SIGTERM ask the run to stop (:meth:`gmuk.runs.RunControl.request_stop`):
+    the simulation running stops at its next step and returns the trajectory so far, later
+    ones return at once, and the scenario finishes with what it has. Yields the list of the
+    signals received (main thread only; elsewhere the handlers cannot be set and the list
+    stays empty)."""
     received: list[int] = []
 
     def stop(signum: int, frame: FrameType | None) -> None:
         received.append(signum)
-        raise KeyboardInterrupt
+        control.request_stop()
 
     if threading.current_thread() is not threading.main_thread():
         yield received
@@ -134,9 +163,39 @@ def _stopping_signals() -> Iterator[list[int]]:
             signal.signal(sig, handler)
 
 
+#: Where ``gmuk run`` keeps the checkpoints of a run, inside its output folder.
+CHECKPOINTS = ".checkpoints"
+
+
+def _resumed(
+    args: argparse.Namespace, scenario: Scenario, name_given: bool, given: dict[str, str]
+) -> tuple[Scenario, dict[str, Any], Path]:
+    """The scenario, options and output folder of the run to resume from ``--resume DIR``."""
+    out: Path = args.resume
+    record_path = out / CHECKPOINTS / "run.json"
+    try:
+        record = json.loads(record_path.read_text())
+        name, shown = record["scenario"], dict(record["options"])
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise OptionError(
+            f"--resume {str(out)!r}: no run to resume there ({record_path} is missing or "
+            f"unreadable: {type(exc).__name__})"
+        ) from None
+    if name_given and name != scenario.name:
+        raise OptionError(f"--resume {str(out)!r} holds a {name!r} run, not {scenario.name!r}")
+    if given or args.out is not None:
+        raise OptionError(
+            "--resume takes the options and the output folder of the run it continues; "
+            "give no other scenario option or --out"
+        )
+    resumed = scenarios.get(name)
+    return resumed, resumed.parse_options(shown), out
+
+
 def _run(argv: Sequence[str]) -> int:
     argv = list(argv)
-    name = argv.pop(0) if argv and not argv[0].startswith("-") else DEFAULT_SCENARIO
+    name_given = bool(argv) and not argv[0].startswith("-")
+    name = argv.pop(0) if name_given else DEFAULT_SCENARIO
     scenario = scenarios.get(name)
     args, unknown = _run_parser(scenario).parse_known_args(argv)
     if unknown:
@@ -156,15 +215,27 @@ def _run(argv: Sequence[str]) -> int:
         for key, value in vars(args).items()
         if key.startswith("option:") and value is not None
     }
-    options = scenario.parse_options(given)
-    out = args.out or Path("gmuk-out") / scenario.name
+    if args.resume is not None:
+        scenario, options, out = _resumed(args, scenario, name_given, given)
+    else:
+        options = scenario.parse_options(given)
+        out = args.out or Path("gmuk-out") / scenario.name
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OptionError(f"--out {str(out)!r}: cannot make the output folder: {exc}") from None
+    folder = out / CHECKPOINTS
+    every = args.checkpoint_every if args.checkpoint_every > 0 else float("inf")
+    if args.resume is None:
+        shutil.rmtree(folder, ignore_errors=True)  # a new run: no stale checkpoints
+        folder.mkdir()
+        texts = {o.name: o.show(options[o.name]) for o in scenario.options}
+        record = {"scenario": scenario.name, "options": texts}
+        write_text_atomic(folder / "run.json", json.dumps(record, indent=2) + "\n")
     t0 = time.perf_counter()
-    with _stopping_signals() as received:
-        result = scenario.run(**options)
+    with runs.run_control(folder, every_s=every, resume=args.resume is not None) as control:
+        with _stopping_signals(control) as received:
+            result = scenario.run(**options)
     elapsed = time.perf_counter() - t0
     primary = result.trajectories[result.primary]
     stopped = [k for k, v in result.trajectories.items() if v.status != "success"]
@@ -185,10 +256,13 @@ def _run(argv: Sequence[str]) -> int:
     if received:
         print(
             f"{result.name}: stopped by {signal.Signals(received[0]).name} at "
-            f"t = {summary['t_reached_s']:.6g} s; wrote {path} and {out / 'summary.json'}",
+            f"t = {summary['t_reached_s']:.6g} s; wrote {path} and {out / 'summary.json'}; "
+            f"continue with: gmuk run --resume {out}",
             file=sys.stderr,
         )
         return EXIT_STATUS[signal.Signals(received[0])]
+    if not stopped:
+        shutil.rmtree(folder, ignore_errors=True)  # complete: the checkpoints are spent
     extra = scenario.write_data(result, out) if scenario.write_data is not None else []
     figures = [] if args.no_plots else scenario.figures(result, out, formats)
     shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)

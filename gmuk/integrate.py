@@ -35,13 +35,16 @@ Munthe-Kaas, "High order Runge–Kutta methods on manifolds", Appl. Numer. Math.
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 import warnings
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk import runs
 from gmuk._validation import FloatArray, real_number
 from gmuk.errors import DefinitionError, GmukError, GmukWarning, SimulationError
 
@@ -56,7 +59,7 @@ from gmuk.integrators import method_names as method_names
 from gmuk.integrators._base import label
 from gmuk.lie import _kernels
 from gmuk.state import State
-from gmuk.trajectory import Trajectory
+from gmuk.trajectory import _ARRAYS, Trajectory
 
 if TYPE_CHECKING:
     from gmuk.system import Accelerations, System
@@ -90,7 +93,7 @@ class _Problem:
         if pts:
             cols = np.array(pts, dtype=np.intp)[:, None] + np.arange(3)
             self.point_idx = np.concatenate([self.s_x.start + cols, self.s_xd.start + cols])
-        self.G0 = np.zeros((self.nr, 4, 4))
+        self.G0: FloatArray = np.zeros((self.nr, 4, 4))
         self.acc: Accelerations | None = None
         self.n_rhs = 0
 
@@ -182,9 +185,11 @@ class _Problem:
 class _Recorder:
     """Collects output states and their diagnostics."""
 
-    def __init__(self, problem: _Problem) -> None:
+    def __init__(self, problem: _Problem, prefix: Trajectory | None = None) -> None:
         self.p = problem
         self.rows: list[tuple[State, Accelerations]] = []
+        # The outputs of a resumed run's checkpoint, which come before the rows.
+        self.prefix = prefix
 
     def add(self, state: State, acc: Accelerations | None = None) -> None:
         if acc is None:
@@ -200,10 +205,12 @@ class _Recorder:
             return np.array([fn(s, a) for s, a in rows]).reshape((n, *shape))
 
         s_rows = {a.multipliers.size for _, a in rows}
+        if self.prefix is not None:
+            s_rows.add(self.prefix.multipliers.shape[1])
         n_mult = s_rows.pop() if len(s_rows) == 1 else 0
         if len(s_rows) > 0:
             raise GmukError("the number of constraint rows changed during the run")
-        return Trajectory(
+        traj = Trajectory(
             t=np.array([s.t for s, _ in rows]),
             g_NB=stack(lambda s, a: s.g, (lay.n_rigid, 4, 4)),
             V_B=stack(lambda s, a: s.V, (lay.n_rigid, 6)),
@@ -225,6 +232,13 @@ class _Recorder:
             message=message,
             stats=stats,
         )
+        if self.prefix is None:
+            return traj
+        joined: dict[str, Any] = {
+            name: np.concatenate([getattr(self.prefix, name), getattr(traj, name)])
+            for name in _ARRAYS
+        }
+        return dataclasses.replace(traj, **joined)
 
 
 class _Progress:
@@ -365,13 +379,38 @@ def simulate(
     if progress is not None and not isinstance(progress, (bool, np.bool_)):
         raise DefinitionError(f"progress must be True, False or None; got {progress!r}")
 
+    state0 = state0.replace(t=t0)
+    control = runs.current()
+    checkpoint = control.next_path() if control is not None else None
+    prefix: Trajectory | None = None
+    record: dict[str, Any] | None = None
+    fingerprint = ""
+    if checkpoint is not None:
+        settings = {
+            "t_span": (t0, t1),
+            "method": label(m),
+            "rtol": rtol,
+            "atol": atol,
+            "step": step,
+            "first_step": first_step,
+            "max_step": max_step,
+        }
+        fingerprint = runs.fingerprint(state0, settings, outs)
+        if control is not None and control.resume and checkpoint.exists():
+            prefix, record = runs.load(checkpoint, fingerprint)
+            if record["complete"]:
+                return prefix
     prob = _Problem(system)
-    rec = _Recorder(prob)
+    rec = _Recorder(prob, prefix)
     stepper = _Stepper(prob, m, rtol, atol, step, first_step, max_step)
+    stepper.control, stepper.checkpoint = control, checkpoint
+    stepper.fingerprint, stepper.recorder = fingerprint, rec
     bar = _Progress(progress, t0, t1)
     status, message = "success", ""
     try:
-        stepper.run(state0.replace(t=t0), t1, outs, rec, max_steps, bar)
+        stepper.run(state0, t1, outs, rec, max_steps, bar, resume=record)
+    except _StopRequested:
+        status, message = "interrupted", f"stopped on request at t = {stepper.t:.9g} s"
     except KeyboardInterrupt:
         status, message = "interrupted", f"interrupted by the user at t = {stepper.t:.9g} s"
         warnings.warn(message + "; returning the trajectory so far", GmukWarning, stacklevel=2)
@@ -381,10 +420,17 @@ def simulate(
         if on_failure == "raise":
             traj = rec.build(status, message, stepper.stats())
             bar.close()
+            stepper.save_checkpoint(traj)
             raise SimulationError(message, traj) from exc
     finally:
         bar.close()
-    return rec.build(status, message, stepper.stats())
+    traj = rec.build(status, message, stepper.stats())
+    stepper.save_checkpoint(traj)
+    return traj
+
+
+class _StopRequested(Exception):
+    """The run's RunControl asked the simulation to stop (gmuk.runs)."""
 
 
 def _step_factor(err: float, order: int) -> float:
@@ -420,6 +466,45 @@ class _Stepper:
         self.max_step = max_step
         self.t = 0.0
         self.n_steps = self.n_rejected = 0
+        # Checkpointing (gmuk.runs): the last accepted step's integrator state.
+        self.control: runs.RunControl | None = None
+        self.checkpoint: Path | None = None
+        self.fingerprint = ""
+        self.recorder: _Recorder | None = None
+        self.last_save = time.monotonic()
+        self.at: tuple[FloatArray, FloatArray, float, int] | None = None  # Y, G0, h, out_i
+
+    def save_checkpoint(self, traj: Trajectory | None = None) -> None:
+        """Write the checkpoint (the trajectory so far and the last accepted step)."""
+        if self.checkpoint is None or self.at is None:
+            return
+        Y, G0, h, out_i = self.at
+        if traj is None:
+            assert self.recorder is not None
+            traj = self.recorder.build("interrupted", "checkpoint", self.stats())
+        record = {
+            "fingerprint": self.fingerprint,
+            "complete": traj.status == "success",
+            "t": self.t,
+            "h": h,
+            "out_i": out_i,
+            "Y": Y.tolist(),
+            "G0": G0.ravel().tolist(),
+            "n_steps": self.n_steps,
+            "n_rejected": self.n_rejected,
+            "n_rhs": self.p.n_rhs,
+        }
+        runs.save(self.checkpoint, traj, record)
+        self.last_save = time.monotonic()
+
+    def _after_step(self) -> None:
+        control = self.control
+        if control is None:
+            return
+        if control.stop_requested:
+            raise _StopRequested
+        if self.checkpoint is not None and time.monotonic() - self.last_save >= control.every_s:
+            self.save_checkpoint()
 
     def stats(self) -> dict[str, Any]:
         return {
@@ -455,6 +540,7 @@ class _Stepper:
         rec: _Recorder,
         max_steps: int,
         bar: _Progress,
+        resume: dict[str, Any] | None = None,
     ) -> None:
         p, m = self.p, self.method
         f = p.rhs
@@ -463,17 +549,39 @@ class _Stepper:
         dense = m.dense_output and outs is not None
         step_to_outputs = m.steps_onto_outputs and outs is not None
         rtol, atol = self.rtol, self.atol
-        t = self.t = state0.t
-        G0 = p.G0 = state0.g.copy()
-        Y = p.pack(state0)
-        f0 = f(t, Y)
-        acc0 = p.acc
-        assert acc0 is not None
-        out_i = 0
-        if outs is None or outs[0] == t:
-            rec.add(state0, acc0)
-            out_i = 0 if outs is None else 1
-        h = self._initial_step(t, Y, f0, t_end) if adaptive else float(self.fixed or 0)
+        G0: FloatArray
+        Y: FloatArray
+        if resume is not None:  # from the last accepted step of a checkpoint (gmuk.runs)
+            t = self.t = float(resume["t"])
+            G0 = np.array(resume["G0"], dtype=float).reshape(state0.g.shape)
+            p.G0 = G0
+            Y = np.array(resume["Y"], dtype=float)
+            if Y.shape != (p.size,):
+                raise runs.CheckpointError(
+                    f"checkpoint state has {Y.size} entries; expected {p.size}"
+                )
+            p.n_rhs = int(resume.get("n_rhs", 0))
+            self.n_steps = int(resume.get("n_steps", 0))
+            self.n_rejected = int(resume.get("n_rejected", 0))
+            f0 = f(t, Y)
+            out_i = int(resume["out_i"])
+            h = float(resume["h"])
+        else:
+            t = self.t = state0.t
+            G0 = p.G0 = state0.g.copy()
+            Y = p.pack(state0)
+            if self.control is not None and self.control.stop_requested:
+                rec.add(state0)  # asked to stop before starting: the initial state only
+                raise _StopRequested
+            f0 = f(t, Y)
+            acc0 = p.acc
+            assert acc0 is not None
+            out_i = 0
+            if outs is None or outs[0] == t:
+                rec.add(state0, acc0)
+                out_i = 0 if outs is None else 1
+            h = self._initial_step(t, Y, f0, t_end) if adaptive else float(self.fixed or 0)
+        self.at = (Y, G0, h, out_i)
         while t < t_end:
             if self.n_steps >= max_steps:
                 raise _StepFailure(f"reached max_steps = {max_steps}")
@@ -535,4 +643,6 @@ class _Stepper:
             p.G0 = G0
             self.t = t
             self.n_steps += 1
+            self.at = (Y, G0, h, out_i)
             bar.update(t)
+            self._after_step()

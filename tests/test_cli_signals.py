@@ -9,6 +9,7 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 import gmuk
@@ -55,3 +56,93 @@ def test_a_completed_run_says_success(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "success" and "signal" not in summary
     assert summary["t_reached_s"] == pytest.approx(0.02 * 22696.0, rel=1e-3)
+
+
+def _maintenance(out, *extra):
+    return [
+        sys.executable,
+        "-m",
+        "gmuk.cli",
+        "run",
+        "maintenance",
+        "--orbits",
+        "10",
+        "--no-plots",
+        "--checkpoint-every",
+        "1",
+        "--out",
+        str(out),
+        *extra,
+    ]
+
+
+def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_result(tmp_path):
+    out = tmp_path / "killed"
+    proc = subprocess.Popen(
+        _maintenance(out, "--compare", "false"), stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    checkpoint = out / ".checkpoints" / "run-0.npz"
+    deadline = time.monotonic() + 60.0
+    while not checkpoint.exists() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    time.sleep(1.5)  # a checkpoint or two further into the run
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate(timeout=60)
+    assert proc.returncode == -signal.SIGKILL
+    assert not (out / "trajectory.npz").exists()
+    partial = gmuk.load_trajectory(checkpoint)  # readable: written atomically
+    assert partial.stats["checkpoint"]["complete"] is False
+    assert 0.0 < partial.t[-1] < 10 * 7071.0
+    resumed = subprocess.run(
+        [sys.executable, "-m", "gmuk.cli", "run", "--resume", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    assert not (out / ".checkpoints").exists()  # spent
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "success" and summary["options"]["compare"] is False
+    from gmuk.scenarios import maintenance
+
+    plain = maintenance.run(orbits=10.0, compare=False).trajectories["maintenance"]
+    back = gmuk.load_trajectory(out / "trajectory.npz")
+    np.testing.assert_array_equal(back.t, plain.t)
+    np.testing.assert_allclose(back.r_N, plain.r_N, rtol=0, atol=1e-6)
+
+
+def test_a_stop_ends_every_simulation_of_a_scenario_and_resume_completes_them(tmp_path):
+    out = tmp_path / "three"
+    proc = subprocess.Popen(_maintenance(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    time.sleep(6.0)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 143, stderr
+    assert b"continue with: gmuk run --resume" in stderr
+    summary = json.loads((out / "summary.json").read_text())
+    # the primary run stopped; the two that follow it returned at once
+    assert summary["runs_not_completed"] == ["maintenance", "position_only", "free"]
+    resumed = subprocess.run(
+        [sys.executable, "-m", "gmuk.cli", "run", "maintenance", "--resume", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "success" and "runs_not_completed" not in summary
+    assert summary["bound_excess_max"] <= 0.0
+
+
+def test_resume_refuses_what_it_cannot_continue(tmp_path, capsys):
+    assert gmuk.cli.main(["run", "--resume", str(tmp_path)]) == 2
+    assert "no run to resume there" in capsys.readouterr().err
+    record = tmp_path / ".checkpoints"
+    record.mkdir()
+    (record / "run.json").write_text(json.dumps({"scenario": "smd-gt", "options": {}}))
+    assert gmuk.cli.main(["run", "fcei", "--resume", str(tmp_path)]) == 2
+    assert "holds a 'smd-gt' run, not 'fcei'" in capsys.readouterr().err
+    assert gmuk.cli.main(["run", "smd-gt", "--resume", str(tmp_path), "--duration", "2"]) == 2
+    assert "give no other scenario option or --out" in capsys.readouterr().err

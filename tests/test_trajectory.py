@@ -171,3 +171,12 @@ def test_corrupted_truncated_or_edited_files_are_format_errors(traj, tmp_path):
         gmuk.load_trajectory(tmp_path)
     with pytest.raises(FileFormatError, match=r"path must be a str or os\.PathLike"):
         gmuk.load_trajectory(None)
+
+
+def test_saved_files_get_the_permissions_open_would_give(traj, tmp_path):
+    import os
+
+    mask = os.umask(0o022)
+    os.umask(mask)
+    path = traj.save(tmp_path / "perm.npz")
+    assert path.stat().st_mode & 0o777 == 0o666 & ~mask
