@@ -297,6 +297,38 @@ class DenseSolver(UKSolver):
         self._Minv_sqrt = system._Minv_sqrt
         self._unconstrained = not system.constraints
 
+    def accelerations(self, state: State) -> Accelerations:
+        """The general path, or for a System without constraints the free motion alone."""
+        if not self._unconstrained:
+            return self._general(state, *self._loads(state), None)
+        system = self.system
+        modeled, unmodeled = self._loads(state)
+        a = system._free(state, modeled)
+        control, z_dot = system._controls(state, a)
+        if system._plant_only_loads:
+            extra = system._apply_Minv(unmodeled + control)
+            total = a + extra
+        else:
+            extra, total = system._zero_loads, a
+        zero = system._zero_loads  # shared, read-only
+        return Accelerations._from_dict(
+            {
+                "layout": system.layout,
+                "free": a,
+                "constraint": zero,
+                "extra": extra,
+                "total": total,
+                "constraint_force": zero,
+                "control_force": control,
+                "unmodeled_force": unmodeled,
+                "multipliers": _NO_MULTIPLIERS,
+                "residual": 0.0,
+                "rank": 0,
+                "unreachable": 0.0,
+                "z_dot": z_dot,
+            }
+        )
+
     def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:
         """QR or SVD solve of the stacked dense rows."""
         if self._unconstrained and rows is None:  # nothing to stack or solve

@@ -308,6 +308,14 @@ class System:
             else:
                 bs = [self._resolve(r) for r in f.bodies]
             self._force_bodies.append(bs)
+        # Force models that keep ForceModel.wrenches are called per body directly, with each
+        # body's slot looked up here once: (model, [(body, rigid?, index, offset, dof)]);
+        # the others through their wrenches() (slots None). In the models' order.
+        self._force_plan = [
+            (f, bs, [self._force_slot(b) for b in bs] if direct else None)
+            for f, bs in zip(self.forces, self._force_bodies, strict=True)
+            for direct in [type(f).wrenches is ForceModel.wrenches]
+        ]
         self._ctrl_bodies = [[self._resolve(r) for r in c.bodies] for c in self.controllers]
         # The CSR pattern of the stacked rows when every constraint gives dense blocks.
         self._csr_pattern: tuple[Any, np.ndarray, np.ndarray, np.ndarray | None] | None = None
@@ -480,11 +488,31 @@ class System:
             return self._zero_loads, self._zero_loads
         n = self.layout.n_dof
         modeled, unmodeled = np.zeros(n), np.zeros(n)
-        for f, bodies in zip(self.forces, self._force_bodies, strict=True):
+        t = state.t
+        for f, bodies, slots in self._force_plan:
             target = modeled if f.modeled else unmodeled
-            for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
-                self._add(target, body, w, f"force {f.name!r}")
+            if slots is None:
+                for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
+                    self._add(target, body, w, f"force {f.name!r}")
+                continue
+            for body, rigid, i, offset, dof in slots:
+                if rigid:
+                    w = f.wrench(t, state.g[i], state.V[i], body)
+                else:
+                    w = f.force(t, state.x[i : i + dof], state.xdot[i : i + dof], body)
+                if type(w) is not np.ndarray or w.shape != (dof,) or w.dtype != np.float64:
+                    w = np.asarray(w, dtype=float)
+                    if w.shape != (dof,):
+                        raise DefinitionError(
+                            f"force {f.name!r} returned shape {w.shape} for {body.kind} body "
+                            f"{body.name!r}; expected ({dof},)"
+                        )
+                target[offset : offset + dof] += w
         return modeled, unmodeled
+
+    def _force_slot(self, body: Body) -> tuple[Body, bool, int, int, int]:
+        s = self.layout.slot(body)
+        return body, body.kind is BodyKind.RIGID, s.index, s.offset, s.dof
 
     def _controls(self, state: State, modeled: FloatArray) -> tuple[FloatArray, FloatArray]:
         """The controllers' generalized forces (n_dof,) and internal-state rates, given the
