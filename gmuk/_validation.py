@@ -40,13 +40,7 @@ def as_array(x: Any, tail: tuple[int, ...], name: str, *, batch: bool = True) ->
     if type(x) is np.ndarray and x.dtype == np.float64:
         a = x
     else:
-        try:
-            a = np.asarray(x, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise ShapeError(
-                f"{name} must be a numeric array of shape {_fmt(tail, batch)}; "
-                f"could not convert {type(x).__name__}: {exc}"
-            ) from None
+        a = _real_float64(x, tail, name, batch)
     k = len(tail)
     if a.ndim < k or a.shape[a.ndim - k :] != tail or (not batch and a.ndim != k):
         raise ShapeError(f"{name} must have shape {_fmt(tail, batch)}; got {a.shape}")
@@ -57,6 +51,57 @@ def as_array(x: Any, tail: tuple[int, ...], name: str, *, batch: bool = True) ->
             f"{'y' if bad == 1 else 'ies'} in an array of shape {a.shape}"
         )
     return a
+
+
+#: Python types that convert to float but are not real numbers: never taken silently.
+NOT_REAL = (bool, np.bool_, complex, np.complexfloating, str, bytes, np.str_, np.bytes_)
+
+
+def _real_float64(x: Any, tail: tuple[int, ...], name: str, batch: bool) -> FloatArray:
+    """``x`` as float64, refusing what only pretends to be real numbers: booleans, complex
+    numbers (numpy would drop the imaginary part), strings (``"1.5"`` would be parsed),
+    None and other objects inside arrays, and ragged nesting."""
+
+    def refuse(what: str) -> ShapeError:
+        return ShapeError(
+            f"{name} must be a numeric array of shape {_fmt(tail, batch)} of real numbers; "
+            f"could not convert {type(x).__name__}: {what}"
+        )
+
+    if x is None:
+        raise ShapeError(f"{name} must have shape {_fmt(tail, batch)}; got () (None)")
+    if isinstance(x, NOT_REAL):
+        raise refuse(f"got {x!r:.60}")
+    try:
+        raw = np.asarray(x)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise refuse(str(exc)) from None
+    kind = raw.dtype.kind
+    if kind == "O":  # big ints, Fractions, nested objects: only real numbers pass
+        bad = next((v for v in raw.flat if isinstance(v, NOT_REAL) or v is None), raw)
+        if bad is not raw:
+            raise refuse(f"an element is {type(bad).__name__} {bad!r:.40}")
+    elif kind not in "iuf":
+        raise refuse(f"its dtype is {raw.dtype}, not real numbers")
+    try:
+        return np.asarray(raw, dtype=np.float64)
+    except OverflowError:
+        raise NonFiniteError(
+            f"{name} must be finite; got an integer too large for float64"
+        ) from None
+    except (TypeError, ValueError) as exc:
+        raise refuse(str(exc)) from None
+
+
+def finite_result(out: FloatArray, func: str, arg: str, value: FloatArray) -> FloatArray:
+    """``out``, or :class:`NonFiniteError` if the map ``func`` overflowed (finite input so
+    large, e.g. 1e308, that the result holds NaN or inf)."""
+    if not all_finite(out.reshape(-1)):
+        raise NonFiniteError(
+            f"{func}: {arg} is too large for a finite result in float64 (the map overflows); "
+            f"got max|{arg}| = {float(np.abs(value).max(initial=0.0)):.3g}"
+        )
+    return out
 
 
 @njit(cache=True)
@@ -84,7 +129,8 @@ def _rotation_failure(
         if batch_shape
         else ""
     )
-    det = float(np.linalg.det(R))
+    with np.errstate(all="ignore"):  # entries near 1e308: det is then inf, as reported
+        det = float(np.linalg.det(R))
     return NotOnGroupError(
         f"{name} must be a rotation matrix (RᵀR = I to {tol:g}, det +1){where}; "
         f"got max|RᵀR − I| = {err:.3g}, det = {det:.6g}"
@@ -156,6 +202,8 @@ def real_number(
     bad = isinstance(value, (bool, np.bool_, complex, np.complexfloating, str, bytes))
     try:
         v = float(value) if not bad and np.ndim(value) == 0 else float("nan")
+    except OverflowError:  # an int beyond float64: infinite for our purposes
+        v = float("inf") if value > 0 else float("-inf")
     except (TypeError, ValueError):
         v, bad = float("nan"), True
     if bad or v != v:

@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from gmuk._validation import FloatArray
+from gmuk._validation import NOT_REAL, FloatArray
 from gmuk.dynamics import check_inertia
 from gmuk.errors import DefinitionError, InertiaError
 
@@ -31,8 +31,10 @@ def _check_name(name: Any) -> str:
 
 def _check_mass(mass: Any, name: str) -> float:
     try:
+        if isinstance(mass, NOT_REAL):  # float() would take True and "2" silently
+            raise TypeError
         m = float(mass)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InertiaError(f"{name}: mass must be a positive number (kg); got {mass!r}") from None
     if not np.isfinite(m) or m <= 0.0:
         raise InertiaError(f"{name}: mass must be finite and > 0 (kg); got {m!r}")

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray, as_array, check_se3
+from gmuk._validation import NOT_REAL, FloatArray, as_array, check_se3
 from gmuk.errors import InertiaError
 from gmuk.lie import se3
 
@@ -55,8 +55,10 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
     """
     problems: list[str] = []
     try:
+        if isinstance(mass, NOT_REAL):  # float() would take True and "2" silently
+            raise TypeError
         m = float(mass)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InertiaError(f"{name}: mass must be a positive number (kg); got {mass!r}") from None
     if not np.isfinite(m) or m <= 0.0:
         problems.append(f"mass must be finite and > 0 (kg); got {m!r}")

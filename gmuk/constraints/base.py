@@ -167,6 +167,8 @@ def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[Any, FloatArray]:
         if type(A) is np.ndarray and A.dtype == np.float64 and A.ndim == 2:
             finite_A = bool(np.isfinite(A).all())
         elif sp.issparse(A):
+            if A.dtype.kind not in "biuf":  # astype(float) would drop an imaginary part
+                raise ValueError(f"dtype {A.dtype} is not real")
             A = sp.csr_matrix(A, dtype=float)
             finite_A = bool(np.isfinite(A.data).all())
         else:

@@ -341,14 +341,17 @@ def rotation_errors(R: np.ndarray) -> tuple[float, float, int]:
         for i in range(3):
             for j in range(3):
                 s = M[0, i] * M[0, j] + M[1, i] * M[1, j] + M[2, i] * M[2, j]
-                eo = max(eo, abs(s - (1.0 if i == j else 0.0)))
+                e = abs(s - (1.0 if i == j else 0.0))
+                eo = max(eo, e if e == e else np.inf)  # NaN (inf − inf) is no match
         det = (
             M[0, 0] * (M[1, 1] * M[2, 2] - M[1, 2] * M[2, 1])
             - M[0, 1] * (M[1, 0] * M[2, 2] - M[1, 2] * M[2, 0])
             + M[0, 2] * (M[1, 0] * M[2, 1] - M[1, 1] * M[2, 0])
         )
         ed = abs(det - 1.0)
-        if eo + ed > worst_o + worst_d:
+        if ed != ed:
+            ed = np.inf
+        if eo + ed > worst_o + worst_d or k == 0:
             worst_o, worst_d, idx = eo, ed, k
     return worst_o, worst_d, idx
 
@@ -361,6 +364,8 @@ def se3_errors(g: np.ndarray) -> tuple[float, float, float, int, int]:
     k_row = 0
     for k in range(g.shape[0]):
         e = max(abs(g[k, 3, 0]), abs(g[k, 3, 1]), abs(g[k, 3, 2]), abs(g[k, 3, 3] - 1.0))
+        if e != e:
+            e = np.inf
         if e > worst_row:
             worst_row, k_row = e, k
     orth, det, k_rot = rotation_errors(g[:, :3, :3])

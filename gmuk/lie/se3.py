@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray, all_finite, as_array, check_se3
+from gmuk._validation import FloatArray, all_finite, as_array, check_se3, finite_result
 from gmuk.errors import NotOnGroupError
 from gmuk.lie import _kernels
 from gmuk.lie import so3 as _so3
@@ -114,8 +114,9 @@ def exp(xi: Any) -> FloatArray:
         if all_finite(xi):  # one element, the common case: no reshaping round trip
             g = np.empty((4, 4))
             _kernels._se3_exp(xi, g)
-            return g
-    return _exp(as_array(xi, (6,), "xi"))
+            return finite_result(g, "se3.exp", "xi", xi)
+    xi = as_array(xi, (6,), "xi")
+    return finite_result(_exp(xi), "se3.exp", "xi", xi)
 
 
 def _log(g: FloatArray) -> FloatArray:
@@ -137,7 +138,8 @@ def log(g: Any) -> FloatArray:
         ``ξ = [θ; ρ]`` with ``exp(ξ) = g``. McCann (2020) writes ``ξ = exp(g)^|`` below
         Eq. 19; the map meant is this logarithm (errata).
     """
-    return _log(check_se3(g, "g"))
+    g = check_se3(g, "g")
+    return finite_result(_log(g), "se3.log", "g", g)
 
 
 def _inverse(g: FloatArray) -> FloatArray:
@@ -156,7 +158,8 @@ def inverse(g: Any) -> FloatArray:
     -------
     ndarray, shape (..., 4, 4)
     """
-    return _inverse(check_se3(g, "g"))
+    g = check_se3(g, "g")
+    return finite_result(_inverse(g), "se3.inverse", "g", g)
 
 
 def _Ad(g: FloatArray) -> FloatArray:
@@ -177,7 +180,8 @@ def Ad(g: Any) -> FloatArray:
     -------
     ndarray, shape (..., 6, 6)
     """
-    return _Ad(check_se3(g, "g"))
+    g = check_se3(g, "g")
+    return finite_result(_Ad(g), "se3.Ad", "g", g)
 
 
 def ad(V: Any) -> FloatArray:
@@ -241,7 +245,8 @@ def dexp_inv(xi: Any) -> FloatArray:
     them through exact rearrangements with Taylor series below θ = 2 (see
     :mod:`gmuk.lie._coeffs`), accurate to round-off for every θ in [0, 2π).
     """
-    return _dexp_inv(as_array(xi, (6,), "xi"))
+    xi = as_array(xi, (6,), "xi")
+    return finite_result(_dexp_inv(xi), "se3.dexp_inv", "xi", xi)
 
 
 def _dexp(xi: FloatArray) -> FloatArray:
@@ -266,4 +271,5 @@ def dexp(xi: Any) -> FloatArray:
     -------
     ndarray, shape (..., 6, 6)
     """
-    return _dexp(as_array(xi, (6,), "xi"))
+    xi = as_array(xi, (6,), "xi")
+    return finite_result(_dexp(xi), "se3.dexp", "xi", xi)

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray, as_array, check_rotation
+from gmuk._validation import FloatArray, as_array, check_rotation, finite_result
 from gmuk.errors import NotOnGroupError
 from gmuk.lie import _kernels
 
@@ -85,12 +85,13 @@ def vee(W: Any) -> FloatArray:
         (gmuk does not silently drop the symmetric part).
     """
     W = as_array(W, (3, 3), "W")
-    asym = np.abs(W + np.swapaxes(W, -1, -2)).max(initial=0.0)
+    # in halves: W + Wᵀ itself would overflow for entries near 1e308
+    half = float(np.abs(0.5 * W + 0.5 * np.swapaxes(W, -1, -2)).max(initial=0.0))
     scale = max(1.0, float(np.abs(W).max(initial=0.0)))
-    if asym > SKEW_TOL * scale:
+    if half > 0.5 * SKEW_TOL * scale:
         raise NotOnGroupError(
             f"W must be skew-symmetric (W + Wᵀ = 0 to {SKEW_TOL:g} relative); "
-            f"got max|W + Wᵀ| = {asym:.3g}"
+            f"got max|W + Wᵀ| = {2.0 * half:.3g}"
         )
     return _vee(W)
 
@@ -114,7 +115,8 @@ def exp(w: Any) -> FloatArray:
         ``R = cos θ I + (sin θ/θ) w^× + ((1 − cos θ)/θ²) w wᵀ``; no series switch is
         needed because both coefficients are evaluated as sinc functions.
     """
-    return _exp(as_array(w, (3,), "w"))
+    w = as_array(w, (3,), "w")
+    return finite_result(_exp(w), "so3.exp", "w", w)
 
 
 def _log(R: FloatArray) -> FloatArray:
