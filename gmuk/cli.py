@@ -263,8 +263,18 @@ def _run(argv: Sequence[str]) -> int:
         return EXIT_STATUS[signal.Signals(received[0])]
     if not stopped:
         shutil.rmtree(folder, ignore_errors=True)  # complete: the checkpoints are spent
-    extra = scenario.write_data(result, out) if scenario.write_data is not None else []
-    figures = [] if args.no_plots else scenario.figures(result, out, formats)
+    with _stopping_signals(control) as received:  # a signal now ends the run after this step
+        extra = scenario.write_data(result, out) if scenario.write_data is not None else []
+        figures = [] if args.no_plots or received else scenario.figures(result, out, formats)
+    if received:
+        print(
+            f"{result.name}: stopped by {signal.Signals(received[0]).name} after the run "
+            f"completed; wrote {path}, {out / 'summary.json'} and {len(figures)} figure "
+            "file(s); the figures may be incomplete (gmuk run … --resume is not needed: "
+            "run again to make them)",
+            file=sys.stderr,
+        )
+        return EXIT_STATUS[signal.Signals(received[0])]
     shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)
     print(f"{result.name}{f' ({shown})' if shown else ''}: {elapsed:.2f} s")
     for key, value in result.summary.items():

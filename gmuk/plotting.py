@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk._validation import FloatArray
-from gmuk.trajectory import Trajectory
+from gmuk.trajectory import Trajectory, atomic_write
 
 if TYPE_CHECKING:
     from gmuk.kkt import InequalityKKT
@@ -241,12 +241,17 @@ def _time_axis(ax: Any, t: FloatArray, t_scale: str, t_linear: float) -> None:
 
 
 def _save(plt: Any, fig: Any, out: Path, formats: Sequence[str]) -> list[Path]:
+    """Write ``fig`` once per format, each file atomically (a stopped run leaves no half
+    figure), and close it."""
     paths = []
-    for fmt in formats:
-        path = out.with_suffix(f".{fmt}")
-        fig.savefig(path, dpi=150)
-        paths.append(path)
-    plt.close(fig)
+    try:
+        for fmt in formats:
+            path = out.with_suffix(f".{fmt}")
+            with atomic_write(path) as tmp:
+                fig.savefig(tmp, dpi=150, format=fmt)
+            paths.append(path)
+    finally:
+        plt.close(fig)
     return paths
 
 
