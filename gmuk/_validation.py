@@ -222,7 +222,11 @@ def check_sequence(value: Any, name: str) -> tuple[Any, ...]:
 
     from gmuk.errors import DefinitionError
 
-    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
+    if (
+        isinstance(value, (str, bytes))
+        or not isinstance(value, (Sequence, np.ndarray))
+        or (isinstance(value, np.ndarray) and value.ndim == 0)  # cannot be iterated
+    ):
         raise DefinitionError(
             f"{name} must be a sequence (list or tuple); got {type(value).__name__} {value!r:.60}"
         )

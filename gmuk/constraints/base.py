@@ -197,6 +197,8 @@ def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[Any, FloatArray]:
 
 def _real_array(x: Any) -> FloatArray:
     """``x`` as a float64 array; complex, string or object data is a ValueError."""
+    if isinstance(x, (bool, np.bool_)):  # a lone True/False is no row value
+        raise ValueError(f"{x!r} is a bool, not a real number")
     arr = np.asarray(x)
     if arr.dtype.kind not in "biuf":
         raise ValueError(f"dtype {arr.dtype} is not real")

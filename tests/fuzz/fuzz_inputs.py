@@ -21,7 +21,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from gmuk.errors import GmukError
+from gmuk.errors import GmukError, GmukWarning
 
 #: Inputs each entry point received in this process, by entry point.
 COUNTS: collections.Counter[str] = collections.Counter()
@@ -46,6 +46,7 @@ def outcome(entry: str, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> An
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             warnings.simplefilter("ignore", DeprecationWarning)
+            warnings.simplefilter("ignore", GmukWarning)  # gmuk's own, documented warnings
             out = fn(*args, **kwargs)
     except GmukError as exc:
         assert str(exc), f"{entry}: a GmukError without a message"

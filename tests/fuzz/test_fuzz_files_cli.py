@@ -212,9 +212,8 @@ def trajectory_files(draw):
     if how == "drop":
         del members[key]
     elif how == "member":
-        members[key] = draw(
-            st.one_of(st.sampled_from(HOSTILE_ARRAYS), st.just(members[key] * np.nan))
-        )
+        nan_copy = members[key] * np.nan if members[key].dtype.kind in "fiu" else members[key]
+        members[key] = draw(st.one_of(st.sampled_from(HOSTILE_ARRAYS), st.just(nan_copy)))
     else:  # edit the metadata JSON
         meta_key = next((k for k in keys if "meta" in k), key)
         try:
@@ -243,6 +242,45 @@ def _holds_non_finite(data: bytes) -> bool:
 
 @pytest.mark.xfail(
     strict=True,
+    reason="gmuk/trajectory.py load_trajectory (not ours to edit now): a flipped byte in a "
+    "zip header (compression method, encryption flag) escapes as zipfile's raw "
+    "NotImplementedError/RuntimeError; catch them beside BadZipFile as FileFormatError",
+)
+@pytest.mark.parametrize(("offset", "value"), [(8, 99), (6, 1)])
+def test_load_trajectory_refuses_a_zip_header_it_cannot_read(offset, value):
+    data = bytearray(_saved())
+    data[offset] = value  # first local header: compression method / flag bits
+    path = _fresh(".npz")
+    path.write_bytes(bytes(data))
+    with pytest.raises(gmuk.errors.FileFormatError):
+        gmuk.load_trajectory(path)
+
+
+def _bad_z(data: bytes) -> bool:
+    try:
+        with np.load(io.BytesIO(data), allow_pickle=False) as z:
+            return "z" in z.files and z["z"].ndim != 2
+    except Exception:
+        return False
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="gmuk/trajectory.py (not ours to edit now): a file whose z is not 2-D loads, then "
+    "Trajectory.layout raises a raw IndexError (z.shape[1]); load_trajectory should check "
+    "z's shape (N, n_control) and raise FileFormatError",
+)
+def test_load_trajectory_refuses_a_z_of_the_wrong_shape():
+    members = _members()
+    members["z"] = np.zeros(4)
+    path = _fresh(".npz")
+    np.savez(path, **members)
+    with pytest.raises(gmuk.errors.FileFormatError, match="z"):
+        gmuk.load_trajectory(path).layout
+
+
+@pytest.mark.xfail(
+    strict=True,
     reason="gmuk/trajectory.py load_trajectory (not ours to edit now) returns a trajectory "
     "whose t, g_NB, V_B, x or xdot hold NaN/inf; it should raise FileFormatError naming "
     "the member",
@@ -259,9 +297,13 @@ def test_load_trajectory_refuses_non_finite_arrays():
 def check_load_trajectory(data) -> None:
     path = _fresh(".npz")
     path.write_bytes(data)
-    if _holds_non_finite(data):
+    if _holds_non_finite(data) or _bad_z(data):
         return  # known: taken silently, see test_load_trajectory_refuses_non_finite_arrays
-    traj = outcome("load_trajectory", gmuk.load_trajectory, path)
+    try:
+        traj = outcome("load_trajectory", gmuk.load_trajectory, path)
+    except (NotImplementedError, RuntimeError) as exc:  # known: zipfile's, see below
+        assert "compression" in str(exc) or "encrypted" in str(exc), exc
+        return
     if traj is REFUSED:
         return
     assert np.isfinite(traj.t).all() and np.isfinite(traj.g_NB).all()
@@ -370,7 +412,9 @@ def check_cli_scenario_option(args) -> None:
         assert (out / "trajectory.npz").is_file()
         summary = json.loads((out / "summary.json").read_text())
         assert summary["scenario"] == "fuzzprobe"
-        assert gmuk.load_trajectory(out / "trajectory.npz").t.size >= 1
+        # a failed probe run (e.g. --rate 1e308) saves an empty trajectory; it says so
+        n = gmuk.load_trajectory(out / "trajectory.npz").t.size
+        assert n >= 1 or summary["status"] != "success"
     else:
         assert not (out / "trajectory.npz").exists()
 
