@@ -39,7 +39,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import Any, NoReturn
 
 from gmuk import runs, scenarios
 from gmuk.errors import GmukError
@@ -53,8 +53,16 @@ DEFAULT_SCENARIO = "fcei"
 FORMATS = ("png", "pdf", "svg")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, whose errors are OptionErrors (main reports them and returns 2)
+    instead of a SystemExit; --help still exits 0."""
+
+    def error(self, message: str) -> NoReturn:
+        raise OptionError(f"{self.prog}: {message}")
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="gmuk", description="List and run the scenarios; check gmuk against Pinocchio."
     )
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
@@ -83,7 +91,7 @@ def _parser() -> argparse.ArgumentParser:
 def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
     """``gmuk run NAME``'s parser: the common flags, then the scenario's declared options."""
     names = ", ".join(s.name for s, _ in scenarios.available())
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog=f"gmuk run {scenario.name}",
         description=scenario.description,
         allow_abbrev=False,

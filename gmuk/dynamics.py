@@ -64,7 +64,7 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
         problems.append(f"mass must be finite and > 0 (kg); got {m!r}")
     Jm = as_array(J, (3, 3), f"{name}: inertia", batch=False)
     scale = max(float(np.abs(Jm).max()), np.finfo(float).tiny)
-    asym = float(np.abs(Jm - Jm.T).max())
+    asym = float(np.abs(Jm / scale - Jm.T / scale).max()) * scale  # no overflow near 1e308
     if asym > INERTIA_TOL * scale:
         problems.append(f"inertia must be symmetric; got max|J − Jᵀ| = {asym:.3g} kg·m²")
     else:

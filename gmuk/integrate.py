@@ -336,23 +336,31 @@ def simulate(
         For an unknown method name (the message lists the registered ones) or bad arguments.
     """
     m = get_method(method)
-    if on_failure not in ("raise", "return"):
+    if not isinstance(on_failure, str) or on_failure not in ("raise", "return"):
         raise DefinitionError(f"on_failure must be 'raise' or 'return'; got {on_failure!r}")
     if not isinstance(state0, State):
         raise DefinitionError(
             f"state0 must be a gmuk.State (from System.state); got {type(state0).__name__}"
         )
-    if isinstance(t_span, (str, bytes)) or np.ndim(t_span) != 1 or len(t_span) != 2:
-        raise DefinitionError(f"t_span must be a pair (start, end) in s; got {t_span!r:.60}")
-    t0, t1 = (real_number(v, "t_span") for v in t_span)
+    pair_error = DefinitionError(
+        f"t_span must be a pair (start, end) of real times in s; got {t_span!r:.60}"
+    )
+    if isinstance(t_span, np.ndarray):
+        if t_span.shape != (2,):
+            raise pair_error
+    elif not isinstance(t_span, (tuple, list)) or len(t_span) != 2:
+        raise pair_error
+    try:
+        t0, t1 = (real_number(v, "t_span") for v in t_span)
+    except DefinitionError as exc:
+        if "finite" in str(exc):
+            raise
+        raise pair_error from None
     if not t1 > t0:
         raise DefinitionError(f"t_span must be finite with end > start; got {t_span!r}")
     if state0.layout != system.layout:
         raise DefinitionError("state0 belongs to another System (layouts differ)")
-    try:
-        outs = None if t_eval is None else np.asarray(t_eval, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise DefinitionError(f"t_eval must be an array of times (s); got {t_eval!r:.60}") from None
+    outs = None if t_eval is None else _times(t_eval)
     if outs is not None and (
         outs.size == 0
         or np.any(np.diff(outs) <= 0)
@@ -427,6 +435,24 @@ def simulate(
     traj = rec.build(status, message, stepper.stats())
     stepper.save_checkpoint(traj)
     return traj
+
+
+def _times(t_eval: Any) -> FloatArray:
+    """``t_eval`` as a 1-D float array of finite real times, or a DefinitionError."""
+    bad = DefinitionError(f"t_eval must be an array of finite real times (s); got {t_eval!r:.60}")
+    try:
+        raw = np.asarray(t_eval)
+    except (TypeError, ValueError, OverflowError):
+        raise bad from None
+    if raw.dtype.kind not in "iuf":
+        raise bad
+    try:
+        outs = raw.astype(float).reshape(-1)
+    except OverflowError:
+        raise bad from None
+    if not np.isfinite(outs).all():
+        raise bad
+    return outs
 
 
 class _StopRequested(Exception):

@@ -354,7 +354,7 @@ class DenseSolver(UKSolver):
                 self.check_consistency(state, residual, scale)
                 return ac, lam, b.size, residual
         ac, lam, rank, residual, norm_Aa = _uk_kernels.uk_dense(A, b, a, self._Minv_sqrt, rcond)
-        self.check_consistency(state, residual, max(1.0, float(np.sqrt(b @ b)), norm_Aa))
+        self.check_consistency(state, residual, max(1.0, float(np.linalg.norm(b)), norm_Aa))
         return ac, lam, rank, residual
 
 

@@ -14,6 +14,7 @@ McCann (2020), Eqs. (2)–(3) (point masses), (63)–(64) (rigid bodies on R⁶)
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -22,11 +23,18 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from gmuk import _uk_kernels, solvers, uk
-from gmuk._validation import FloatArray, as_array, check_se3, check_sequence, real_number
+from gmuk._validation import (
+    FloatArray,
+    all_finite,
+    as_array,
+    check_se3,
+    check_sequence,
+    real_number,
+)
 from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
 from gmuk.control.base import Controller
-from gmuk.errors import ConstraintError, DefinitionError
+from gmuk.errors import ConstraintError, DefinitionError, NonFiniteError
 from gmuk.forces.base import ForceModel
 from gmuk.integrate import simulate as _simulate
 from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
@@ -665,6 +673,11 @@ class System:
         -------
         Accelerations
 
+        Raises
+        ------
+        NonFiniteError
+            When the accelerations overflow (loads or constraint rows too large for float64).
+
         Warns
         -----
         InconsistentConstraintsWarning
@@ -673,7 +686,25 @@ class System:
         """
         if state.layout is not self.layout and state.layout != self.layout:
             raise DefinitionError("state belongs to another System (layouts differ)")
-        return self._accelerations(state)
+        try:
+            acc = self._accelerations(state)
+        except (RuntimeWarning, FloatingPointError) as exc:  # warnings or errstate as errors
+            raise NonFiniteError(
+                f"the accelerations at t = {state.t:.9g} s overflow ({exc}; constraint rows or "
+                "loads too large for float64?)"
+            ) from None
+        if not (
+            all_finite(acc.total)
+            and all_finite(acc.constraint_force)
+            and all_finite(acc.multipliers)
+            and math.isfinite(acc.residual)
+        ):
+            raise NonFiniteError(
+                f"non-finite accelerations (NaN or inf) at t = {state.t:.9g} s: the free "
+                f"acceleration is {'finite' if all_finite(acc.free) else 'not finite'}; are "
+                "the state, the loads or the constraint rows too large for float64?"
+            )
+        return acc
 
     # ------------------------------------------------------------------ simulation
     def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:

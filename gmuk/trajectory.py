@@ -385,7 +385,15 @@ def load_trajectory(path: str | Path) -> Trajectory:
         raise
     except KeyError as exc:
         raise FileFormatError(f"{path}: not a gmuk trajectory (missing {exc})") from None
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
+    except (
+        OSError,
+        ValueError,
+        EOFError,
+        zipfile.BadZipFile,
+        zlib.error,
+        NotImplementedError,  # a flipped compression-method byte
+        RuntimeError,  # a flipped encryption flag
+    ) as exc:
         raise FileFormatError(
             f"{path}: cannot read as a gmuk trajectory .npz (truncated or corrupted?): "
             f"{type(exc).__name__}: {exc}"
@@ -412,6 +420,10 @@ def load_trajectory(path: str | Path) -> Trajectory:
 def _check_consistent(traj: Trajectory, path: Path) -> None:
     """The arrays' shapes agree with the bodies and with each other (a file edited by hand
     or by another program is refused rather than misread)."""
+    if traj.z.ndim != 2:
+        raise FileFormatError(
+            f"{path}: array 'z' has shape {traj.z.shape}; expected (N, n_control)"
+        )
     lay = traj.layout
     n = traj.t.shape[0] if traj.t.ndim == 1 else -1
     expected = {
@@ -437,3 +449,7 @@ def _check_consistent(traj: Trajectory, path: Path) -> None:
             )
     if traj.multipliers.ndim != 2 or traj.multipliers.shape[0] != n:
         raise FileFormatError(f"{path}: array 'multipliers' has shape {traj.multipliers.shape}")
+    for name in _ARRAYS:  # gmuk records finite outputs only
+        values = getattr(traj, name)
+        if values.dtype.kind not in "iuf" or not np.isfinite(values).all():
+            raise FileFormatError(f"{path}: array {name!r} holds non-finite or non-real values")

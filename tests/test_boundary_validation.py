@@ -67,7 +67,7 @@ def test_state_arguments(system):
     [
         ({"method": "RK4", "step": complex(0.1, 1)}, "step must be a number > 0; got (0.1+1j)"),
         ({"method": "RK4", "step": -0.1}, "step must be a number > 0; got -0.1"),
-        ({"t_eval": "abc"}, "t_eval must be an array of times (s); got 'abc'"),
+        ({"t_eval": "abc"}, "t_eval must be an array of finite real times (s); got 'abc'"),
         ({"rtol": "x"}, "rtol must be a number > 0; got 'x'"),
         ({"atol": 0.0}, "atol must be a number > 0; got 0.0"),
         ({"first_step": -1.0}, "first_step must be a number > 0; got -1.0"),

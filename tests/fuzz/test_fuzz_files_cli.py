@@ -231,45 +231,23 @@ def trajectory_files(draw):
     return buf.getvalue()
 
 
-def _holds_non_finite(data: bytes) -> bool:
-    try:
-        with np.load(io.BytesIO(data), allow_pickle=False) as z:
-            arrays = [z[k] for k in z.files]
-    except Exception:  # unreadable: whatever load_trajectory does with it is tested
-        return False
-    return any(a.dtype.kind in "fc" and not np.isfinite(a).all() for a in arrays)
-
-
-@pytest.mark.xfail(
-    strict=True,
-    reason="gmuk/trajectory.py load_trajectory (not ours to edit now): a flipped byte in a "
-    "zip header (compression method, encryption flag) escapes as zipfile's raw "
-    "NotImplementedError/RuntimeError; catch them beside BadZipFile as FileFormatError",
-)
 @pytest.mark.parametrize(("offset", "value"), [(8, 99), (6, 1)])
-def test_load_trajectory_refuses_a_zip_header_it_cannot_read(offset, value):
-    data = bytearray(_saved())
+def test_load_trajectory_reads_or_refuses_a_flipped_zip_header(offset, value):
+    # zipfile reads a member's method from the central directory: a flipped byte in the first
+    # local header may be harmless; if it is not, the error is a FileFormatError
+    original = _saved()
+    data = bytearray(original)
     data[offset] = value  # first local header: compression method / flag bits
-    path = _fresh(".npz")
+    path, clean = _fresh(".npz"), _fresh(".npz")
     path.write_bytes(bytes(data))
-    with pytest.raises(gmuk.errors.FileFormatError):
-        gmuk.load_trajectory(path)
-
-
-def _bad_z(data: bytes) -> bool:
+    clean.write_bytes(original)
     try:
-        with np.load(io.BytesIO(data), allow_pickle=False) as z:
-            return "z" in z.files and z["z"].ndim != 2
-    except Exception:
-        return False
+        traj = gmuk.load_trajectory(path)
+    except gmuk.errors.FileFormatError:
+        return
+    np.testing.assert_array_equal(traj.g_NB, gmuk.load_trajectory(clean).g_NB)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="gmuk/trajectory.py (not ours to edit now): a file whose z is not 2-D loads, then "
-    "Trajectory.layout raises a raw IndexError (z.shape[1]); load_trajectory should check "
-    "z's shape (N, n_control) and raise FileFormatError",
-)
 def test_load_trajectory_refuses_a_z_of_the_wrong_shape():
     members = _members()
     members["z"] = np.zeros(4)
@@ -279,12 +257,6 @@ def test_load_trajectory_refuses_a_z_of_the_wrong_shape():
         gmuk.load_trajectory(path).layout
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="gmuk/trajectory.py load_trajectory (not ours to edit now) returns a trajectory "
-    "whose t, g_NB, V_B, x or xdot hold NaN/inf; it should raise FileFormatError naming "
-    "the member",
-)
 def test_load_trajectory_refuses_non_finite_arrays():
     members = _members()
     members["V_B"] = members["V_B"] * np.nan
@@ -297,13 +269,7 @@ def test_load_trajectory_refuses_non_finite_arrays():
 def check_load_trajectory(data) -> None:
     path = _fresh(".npz")
     path.write_bytes(data)
-    if _holds_non_finite(data) or _bad_z(data):
-        return  # known: taken silently, see test_load_trajectory_refuses_non_finite_arrays
-    try:
-        traj = outcome("load_trajectory", gmuk.load_trajectory, path)
-    except (NotImplementedError, RuntimeError) as exc:  # known: zipfile's, see below
-        assert "compression" in str(exc) or "encrypted" in str(exc), exc
-        return
+    traj = outcome("load_trajectory", gmuk.load_trajectory, path)
     if traj is REFUSED:
         return
     assert np.isfinite(traj.t).all() and np.isfinite(traj.g_NB).all()
@@ -450,12 +416,6 @@ def test_real_scenarios_parse_hostile_option_values_into_values_or_option_errors
                     assert option.name in got
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="gmuk/cli.py (not ours to edit now): argparse's own errors (a bad --checkpoint-every,"
-    " gmuk check --seed x, a value starting with '-') exit through SystemExit(2) instead of "
-    "main returning 2",
-)
 @pytest.mark.parametrize(
     "argv",
     [
