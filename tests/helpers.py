@@ -20,6 +20,17 @@ class Rows(gmuk.Constraint):
         return self.A, self.b
 
 
+class Returns(gmuk.Constraint):
+    """A user constraint on body "a" whose rows() returns whatever it is given."""
+
+    def __init__(self, out):
+        super().__init__(["a"])
+        self.out = out
+
+    def rows(self, state):
+        return self.out
+
+
 class ScrewReference(ReferenceTrajectory):
     """g_d(t) = g0 exp(t ξ): constant body twist V_d = ξ, V̇_d = 0 (closed form)."""
 

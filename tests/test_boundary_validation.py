@@ -6,6 +6,7 @@ import re
 
 import numpy as np
 import pytest
+from helpers import Returns
 
 import gmuk
 from gmuk.errors import ConstraintError, DefinitionError, EulerSequenceError
@@ -20,17 +21,6 @@ def system():
 @pytest.fixture(scope="module")
 def state(system):
     return system.state(g={"a": np.eye(4)}, V={"a": np.zeros(6)})
-
-
-class Returns(gmuk.Constraint):
-    """A user constraint whose rows() returns whatever it is given."""
-
-    def __init__(self, out):
-        super().__init__(["a"])
-        self.out = out
-
-    def rows(self, state):
-        return self.out
 
 
 @pytest.mark.parametrize(

@@ -15,24 +15,18 @@ import pytest
 import gmuk
 
 
+def _maintenance(out, orbits, *extra):
+    """``gmuk run maintenance`` for ``orbits`` orbits into ``out``."""
+    cmd = [sys.executable, "-m", "gmuk.cli", "run", "maintenance", "--orbits", orbits]
+    return [*cmd, "--out", str(out), *extra]
+
+
 @pytest.mark.parametrize(("sig", "status"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_a_stopped_run_saves_what_it_computed_and_says_so(tmp_path, sig, status):
     out = tmp_path / "maintenance"
     # 100 maintained orbits in the degree-150 field take over a minute here: the signal comes
     # well before the end.
-    cmd = [
-        sys.executable,
-        "-m",
-        "gmuk.cli",
-        "run",
-        "maintenance",
-        "--orbits",
-        "100",
-        "--compare",
-        "false",
-        "--out",
-        str(out),
-    ]
+    cmd = _maintenance(out, "100", "--compare", "false")
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(8.0)  # import (compiled kernels cached by the earlier tests) and some orbits
     assert proc.poll() is None, proc.communicate()
@@ -58,28 +52,12 @@ def test_a_completed_run_says_success(tmp_path):
     assert summary["t_reached_s"] == pytest.approx(0.02 * 22696.0, rel=1e-3)
 
 
-def _maintenance(out, *extra):
-    return [
-        sys.executable,
-        "-m",
-        "gmuk.cli",
-        "run",
-        "maintenance",
-        "--orbits",
-        "10",
-        "--no-plots",
-        "--checkpoint-every",
-        "1",
-        "--out",
-        str(out),
-        *extra,
-    ]
-
-
 def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_result(tmp_path):
     out = tmp_path / "killed"
     proc = subprocess.Popen(
-        _maintenance(out, "--compare", "false"), stdout=subprocess.PIPE, stderr=subprocess.PIPE
+        _maintenance(out, "10", "--no-plots", "--checkpoint-every", "1", "--compare", "false"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
     )
     checkpoint = out / ".checkpoints" / "run-0.npz"
     deadline = time.monotonic() + 60.0
@@ -114,7 +92,8 @@ def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_resu
 
 def test_a_stop_ends_every_simulation_of_a_scenario_and_resume_completes_them(tmp_path):
     out = tmp_path / "three"
-    proc = subprocess.Popen(_maintenance(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    cmd = _maintenance(out, "10", "--no-plots", "--checkpoint-every", "1")
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     time.sleep(6.0)
     assert proc.poll() is None, proc.communicate()
     proc.send_signal(signal.SIGTERM)

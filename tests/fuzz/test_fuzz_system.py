@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from fuzz_inputs import REFUSED, arrays, fuzz_pair, honest_real, junk, outcome, poses, scalars
+from helpers import Returns
 from hypothesis import strategies as st
 
 import gmuk
@@ -136,17 +137,6 @@ state_args = st.tuples(
 
 
 # ------------------------------------------------------------ a constraint's rows()
-class Returns(gmuk.Constraint):
-    """A user constraint whose rows() returns whatever it is given."""
-
-    def __init__(self, out):
-        super().__init__(["a"])
-        self.out = out
-
-    def rows(self, state):
-        return self.out
-
-
 def _sparse(x):
     try:
         return sp.csr_matrix(np.asarray(x))
