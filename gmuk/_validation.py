@@ -201,14 +201,15 @@ def real_number(
     kind = "a number > 0" if positive else "a number >= 0" if non_negative else "a real number"
     bad = isinstance(value, (bool, np.bool_, complex, np.complexfloating, str, bytes))
     try:
-        v = float(value) if not bad and np.ndim(value) == 0 else float("nan")
+        bad = bad or np.ndim(value) != 0
+        v = float("nan") if bad else float(value)
     except OverflowError:  # an int beyond float64: infinite for our purposes
         v = float("inf") if value > 0 else float("-inf")
     except (TypeError, ValueError):
         v, bad = float("nan"), True
-    if bad or v != v:
+    if bad:
         raise exc(f"{name} must be {kind}; got {value!r}")
-    if (v in (float("inf"), float("-inf"))) and not allow_inf:
+    if v != v or ((v in (float("inf"), float("-inf"))) and not allow_inf):
         raise exc(f"{name} must be finite; got {value!r}")
     if (positive and not v > 0) or (non_negative and not v >= 0):
         raise exc(f"{name} must be {kind}; got {value!r}")

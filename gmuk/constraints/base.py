@@ -47,10 +47,16 @@ class Baumgarte:
 
     def __post_init__(self) -> None:
         for label in ("alpha", "beta"):
-            v = np.asarray(getattr(self, label), dtype=float)
-            if v.ndim > 1 or not np.all(np.isfinite(v)) or np.any(v < 0.0):
+            raw = getattr(self, label)
+            try:
+                v = np.asarray(raw)
+                real = v.dtype.kind in "iuf"
+                v = v.astype(float) if real else v
+            except (TypeError, ValueError, OverflowError):
+                real = False
+            if not real or v.ndim > 1 or not np.all(np.isfinite(v)) or np.any(v < 0.0):
                 raise DefinitionError(
-                    f"Baumgarte {label} must be a finite scalar or 1-D array ≥ 0; got {v!r}"
+                    f"Baumgarte {label} must be a finite scalar or 1-D array ≥ 0; got {raw!r}"
                 )
             object.__setattr__(self, label, v)
 

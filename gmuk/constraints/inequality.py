@@ -50,11 +50,11 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, as_array, real_number
 from gmuk.bodies import BodyKind, SlackCoordinate
 from gmuk.constraints.base import Baumgarte
 from gmuk.constraints.holonomic import Config, _Differentiable, _kinds_of, body_configs
-from gmuk.errors import ConstraintError, DefinitionError
+from gmuk.errors import ConstraintError, DefinitionError, GmukError
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body
@@ -103,13 +103,7 @@ class Bound:
 def _bound_value(value: Any, label: str, who: str) -> float | None:
     if value is None:
         return None
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise DefinitionError(f"{who}: {label} must be a number; got {value!r}") from None
-    if not math.isfinite(v):
-        raise DefinitionError(f"{who}: {label} must be finite; got {value!r}")
-    return v
+    return real_number(value, f"{who}: {label}")
 
 
 class InequalityConstraint(_Differentiable):
@@ -477,8 +471,13 @@ class PlaneBound(InequalityConstraint):
         baumgarte: Baumgarte | None = None,
         name: str | None = None,
     ) -> None:
-        n = np.asarray(normal, dtype=float)
-        norm = float(np.linalg.norm(n)) if n.shape == (3,) else 0.0
+        try:
+            n = np.array(as_array(normal, (3,), "PlaneBound: normal", batch=False))
+        except GmukError:
+            raise DefinitionError(
+                f"PlaneBound: normal must be a non-zero 3-vector; got {normal!r}"
+            ) from None
+        norm = float(np.linalg.norm(n))
         if not (math.isfinite(norm) and norm > 0.0):
             raise DefinitionError(f"PlaneBound: normal must be a non-zero 3-vector; got {normal!r}")
         super().__init__(

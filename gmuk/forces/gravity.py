@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, real_number
 from gmuk.bodies import BodyKind
 from gmuk.celestial import CelestialBody
 from gmuk.errors import DefinitionError
@@ -35,12 +35,7 @@ __all__ = ["GravityGradient", "PointMassGravity", "SphericalHarmonicGravity"]
 
 
 def _check_mu(mu: float) -> float:
-    m = float(mu)
-    if not (np.isfinite(m) and m > 0):
-        raise DefinitionError(
-            f"mu must be a finite gravitational parameter > 0 (m³/s²); got {mu!r}"
-        )
-    return m
+    return real_number(mu, "mu (gravitational parameter, m³/s²)", positive=True)
 
 
 class PointMassGravity(ForceModel):

@@ -7,9 +7,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray, as_array
+from gmuk._validation import FloatArray, as_array, real_number
 from gmuk.bodies import BodyKind
-from gmuk.errors import DefinitionError
+from gmuk.errors import DefinitionError, GmukError
 from gmuk.forces.base import ForceModel
 
 if TYPE_CHECKING:
@@ -58,8 +58,15 @@ class AppliedWrench(ForceModel):
         if callable(wrench):
             self._fun: Callable[[float], Any] = wrench
         else:
-            w = np.asarray(wrench, dtype=float)
-            if w.shape not in ((6,), (3,)) or not np.isfinite(w).all():
+            try:
+                size = np.shape(wrench)[0] if np.ndim(wrench) == 1 else 6
+                w = np.array(as_array(wrench, (size,), "wrench", batch=False))
+            except (GmukError, ValueError):
+                raise DefinitionError(
+                    f"wrench must be a finite (6,) or (3,) array of real numbers or a "
+                    f"callable; got {wrench!r:.60}"
+                ) from None
+            if w.shape not in ((6,), (3,)):
                 raise DefinitionError(
                     f"wrench must be a finite (6,) or (3,) array or a callable; got shape {w.shape}"
                 )
@@ -143,10 +150,8 @@ class LinearSpringDamper(ForceModel):
         name: str | None = None,
     ) -> None:
         super().__init__(bodies, modeled=modeled, name=name)
-        for label, v in (("stiffness", stiffness), ("damping", damping)):
-            if not (np.isfinite(v) and v >= 0):
-                raise DefinitionError(f"{label} must be finite and ≥ 0; got {v!r}")
-        self.k, self.c = float(stiffness), float(damping)
+        self.k = real_number(stiffness, "stiffness (N/m)", non_negative=True)
+        self.c = real_number(damping, "damping (N·s/m)", non_negative=True)
         self.anchor = as_array(anchor, (3,), "anchor", batch=False)
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
@@ -192,9 +197,7 @@ class SlackDamping(ForceModel):
         name: str | None = None,
     ) -> None:
         super().__init__(bodies, name=name)
-        if not (np.isfinite(coefficient) and coefficient >= 0):
-            raise DefinitionError(f"coefficient must be finite and ≥ 0; got {coefficient!r}")
-        self.c = float(coefficient)
+        self.c = real_number(coefficient, "coefficient", non_negative=True)
 
     def wrenches(self, state: State, bodies: Sequence[Body]) -> list[FloatArray]:
         """−c ẇ (1,) for each slack coordinate."""
@@ -243,16 +246,11 @@ class SpringDamper(ForceModel):
     ) -> None:
         bodies = [body_a] if body_b is None else [body_a, body_b]
         super().__init__(bodies, modeled=modeled, name=name)
-        for label, v in (
-            ("stiffness", stiffness),
-            ("damping", damping),
-            ("rest_length", rest_length),
-        ):
-            if not (np.isfinite(v) and v >= 0):
-                raise DefinitionError(f"{label} must be finite and ≥ 0; got {v!r}")
+        self.k = real_number(stiffness, "stiffness (N/m)", non_negative=True)
+        self.c = real_number(damping, "damping (N·s/m)", non_negative=True)
+        self.l0 = real_number(rest_length, "rest_length (m)", non_negative=True)
         self.point_a = as_array(point_a, (3,), "point_a", batch=False)
         self.point_b = as_array(point_b, (3,), "point_b", batch=False)
-        self.k, self.c, self.l0 = float(stiffness), float(damping), float(rest_length)
         self.anchored = body_b is None
 
     @staticmethod

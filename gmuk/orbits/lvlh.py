@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 
 from gmuk._validation import FloatArray, as_array, check_se3
-from gmuk.errors import NonFiniteError
+from gmuk.errors import DefinitionError, NonFiniteError
 from gmuk.lie import se3
 from gmuk.orbits import _kernels
 from gmuk.orbits.conics import KeplerOrbit
@@ -212,7 +212,9 @@ class LVLHReference(ReferenceTrajectory):
 
     def __init__(self, orbit: KeplerOrbit) -> None:
         if not isinstance(orbit, KeplerOrbit):
-            raise TypeError(f"orbit must be a gmuk.orbits.KeplerOrbit; got {type(orbit).__name__}")
+            raise DefinitionError(
+                f"orbit must be a gmuk.orbits.KeplerOrbit; got {type(orbit).__name__}"
+            )
         self._orbit = orbit
         self._R_NP = np.array(orbit.R_NP)
         # The last evaluation: a constraint and a controller on the same reference ask for
