@@ -113,8 +113,8 @@ def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
         default=60.0,
         metavar="SECONDS",
         help="write a checkpoint of each simulation this often (wall time, s) into "
-        "DIR/.checkpoints, so that a killed run loses at most one interval; 0: never "
-        "(default: 60)",
+        "DIR/.checkpoints, so that a killed run loses at most one interval; 0: only when a "
+        "simulation stops or ends (default: 60)",
     )
     common.add_argument(
         "--resume",

@@ -334,6 +334,14 @@ def simulate(
     ------
     DefinitionError
         For an unknown method name (the message lists the registered ones) or bad arguments.
+    gmuk.runs.CheckpointError
+        When resuming from a checkpoint written by another simulation.
+
+    Notes
+    -----
+    Inside :func:`gmuk.runs.run_control` the call stops at the next step once a stop is
+    requested (``status="interrupted"``, no warning), writes checkpoints of its progress, and
+    resumes from them (see :mod:`gmuk.runs`); ``gmuk run`` uses this.
     """
     m = get_method(method)
     if not isinstance(on_failure, str) or on_failure not in ("raise", "return"):
