@@ -135,7 +135,9 @@ class _Problem:
         """dY/dt at (t, Y) about ``G0``: the method's ``f``. The System's accelerations of
         the latest call are kept in ``acc`` (the step end records them)."""
         self.n_rhs += 1
-        self.acc = acc = self.system.accelerations(self.state(t, Y, self.G0))
+        # the System's unchecked entry: simulate checked the layout once, and dY is checked
+        # for NaN and inf below (System.accelerations would check the results a second time)
+        self.acc = acc = self.system._accelerations(self.state(t, Y, self.G0))
         dY = self.deriv(Y, acc)
         if not np.isfinite(dY).all():
             raise FloatingPointError(f"non-finite derivative at t = {t:.9g} s")
