@@ -1,0 +1,94 @@
+"""Where a right-hand side goes: one FCEI orbit end to end and the per-call cost of its
+parts, and a point mass in the GRAIL field (issue #14's per-RHS overhead).
+
+Rows: ``gmuk.scenarios.fcei.run()`` (median of 7 runs after one warm-up); for the FCEI
+System (built as ``gmuk.scenarios._lvlh.fully_constrained`` builds it) one right-hand side
+``_Problem.rhs`` at a new time per call, ``LVLHReference.evaluate`` at a new time and
+``GravityGradient.wrench``; for a 300 kg point mass in GRGM660PRIM to degree 50 one
+right-hand side and the field's acceleration alone. Medians of 7 batches (µs per call).
+
+Run: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_rhs.py
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import itertools
+import math
+import statistics
+import time
+import timeit
+
+import numpy as np
+
+import gmuk
+from gmuk.integrate import _Problem
+from gmuk.orbits import KeplerOrbit, LVLHReference, fcei_orbit
+from gmuk.scenarios import _lvlh as common
+from gmuk.scenarios import fcei
+
+
+def per_call_us(fn, number: int = 5000, repeat: int = 7) -> float:
+    """Median over ``repeat`` batches of the time per call (µs)."""
+    fn()
+    return statistics.median(timeit.repeat(fn, number=number, repeat=repeat)) / number * 1e6
+
+
+def main() -> None:
+    fcei.run()
+    runs = []
+    for _ in range(7):
+        t0 = time.perf_counter()
+        fcei.run()
+        runs.append(time.perf_counter() - t0)
+    rows = [("gmuk.scenarios.fcei.run(), one orbit (s)", statistics.median(runs))]
+
+    orbit = fcei_orbit(common.MU)
+    craft, ref = common.spacecraft(), LVLHReference(orbit)
+    gg = gmuk.GravityGradient(orbit.mu)
+    system = gmuk.System([craft], [gmuk.ConfigurationTracking(craft, ref)], [gg])
+    r0 = ref.evaluate(0.0)
+    state = system.state(g={craft.name: r0.g}, V={craft.name: r0.V})
+    prob = _Problem(system)
+    prob.G0 = state.g.copy()
+    Y = prob.pack(state)
+    times = itertools.count(1.0, 0.37)  # a new time at every call
+    rows += [
+        ("FCEI: one right-hand side (µs)", per_call_us(lambda: prob.rhs(next(times), Y))),
+        ("FCEI: LVLHReference.evaluate (µs)", per_call_us(lambda: ref.evaluate(next(times)))),
+        (
+            "FCEI: GravityGradient.wrench (µs)",
+            per_call_us(lambda: gg.wrench(1.0, state.g[0], state.V[0], craft)),
+        ),
+    ]
+
+    gravity = gmuk.SphericalHarmonicGravity("GRGM660PRIM", degree=50)
+    ellipse = KeplerOrbit.from_elements(1838e3, 0.0, math.radians(80), 0, 0, gravity.field.mu)
+    mass = gmuk.PointMass("sc", 300.0)
+    free = gmuk.System([mass], [], [gravity])
+    r, v = ellipse.state(0.0)
+    point = free.state(r={"sc": r}, v={"sc": v})
+    prob2 = _Problem(free)
+    Y2 = prob2.pack(point)
+    rows += [
+        (
+            "point mass, degree 50: one right-hand side (µs)",
+            per_call_us(lambda: prob2.rhs(1.0, Y2)),
+        ),
+        (
+            "point mass, degree 50: the field's acceleration alone (µs)",
+            per_call_us(lambda: gravity.field.acceleration(np.asarray(r))),
+        ),
+    ]
+    print("| quantity | median |")
+    print("|---|---:|")
+    for label, value in rows:
+        print(f"| {label} | {value:.3g} |")
+
+
+if __name__ == "__main__":
+    main()
