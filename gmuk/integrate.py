@@ -35,7 +35,6 @@ Munthe-Kaas, "High order Runge–Kutta methods on manifolds", Appl. Numer. Math.
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 import time
 import warnings
@@ -54,6 +53,7 @@ from gmuk.integrators import DOPRI5 as DOPRI5
 from gmuk.integrators import METHODS as METHODS
 from gmuk.integrators import RK4 as RK4
 from gmuk.integrators import RungeKuttaMethod as RungeKuttaMethod
+from gmuk.integrators import _compiled
 from gmuk.integrators import get_method as get_method
 from gmuk.integrators import method_names as method_names
 from gmuk.integrators._base import label
@@ -185,11 +185,14 @@ class _Problem:
 
 
 class _Recorder:
-    """Collects output states and their diagnostics."""
+    """Collects output states and their diagnostics: rows of (State, Accelerations) from the
+    Python loop, and blocks of arrays from the compiled one, in the order they come."""
 
     def __init__(self, problem: _Problem, prefix: Trajectory | None = None) -> None:
         self.p = problem
         self.rows: list[tuple[State, Accelerations]] = []
+        # Earlier output: column blocks (dicts of arrays), each followed by the rows after it.
+        self.blocks: list[dict[str, Any]] = []
         # The outputs of a resumed run's checkpoint, which come before the rows.
         self.prefix = prefix
 
@@ -198,35 +201,52 @@ class _Recorder:
             acc = self.p.system.accelerations(state)
         self.rows.append((state, acc))
 
-    def build(self, status: str, message: str, stats: dict[str, Any]) -> Trajectory:
+    def add_block(self, columns: dict[str, Any]) -> None:
+        """Append outputs given as arrays (the compiled loop's buffers)."""
+        if self.rows:
+            self.blocks.append(self._columns(self.rows))
+            self.rows = []
+        self.blocks.append(columns)
+
+    def _columns(self, rows: list[tuple[State, Accelerations]]) -> dict[str, Any]:
         lay = self.p.layout
-        rows = self.rows
         n = len(rows)
 
         def stack(fn: Any, shape: tuple[int, ...]) -> FloatArray:
             return np.array([fn(s, a) for s, a in rows]).reshape((n, *shape))
 
         s_rows = {a.multipliers.size for _, a in rows}
-        if self.prefix is not None:
-            s_rows.add(self.prefix.multipliers.shape[1])
-        n_mult = s_rows.pop() if len(s_rows) == 1 else 0
-        if len(s_rows) > 0:
+        if len(s_rows) > 1:
             raise GmukError("the number of constraint rows changed during the run")
-        traj = Trajectory(
-            t=np.array([s.t for s, _ in rows]),
-            g_NB=stack(lambda s, a: s.g, (lay.n_rigid, 4, 4)),
-            V_B=stack(lambda s, a: s.V, (lay.n_rigid, 6)),
-            x=stack(lambda s, a: s.x, (lay.n_euclid,)),
-            xdot=stack(lambda s, a: s.xdot, (lay.n_euclid,)),
-            z=stack(lambda s, a: s.z, (lay.n_control,)),
-            acceleration=stack(lambda s, a: a.total, (lay.n_dof,)),
-            constraint_acceleration=stack(lambda s, a: a.constraint, (lay.n_dof,)),
-            constraint_force=stack(lambda s, a: a.constraint_force, (lay.n_dof,)),
-            control_force=stack(lambda s, a: a.control_force, (lay.n_dof,)),
-            unmodeled_force=stack(lambda s, a: a.unmodeled_force, (lay.n_dof,)),
-            multipliers=stack(lambda s, a: a.multipliers, (n_mult,)),
-            residual=np.array([a.residual for _, a in rows]),
-            rank=np.array([-1 if a.rank is None else a.rank for _, a in rows], dtype=np.int64),
+        n_mult = s_rows.pop() if s_rows else 0
+        return {
+            "t": np.array([s.t for s, _ in rows], dtype=float),
+            "g_NB": stack(lambda s, a: s.g, (lay.n_rigid, 4, 4)),
+            "V_B": stack(lambda s, a: s.V, (lay.n_rigid, 6)),
+            "x": stack(lambda s, a: s.x, (lay.n_euclid,)),
+            "xdot": stack(lambda s, a: s.xdot, (lay.n_euclid,)),
+            "z": stack(lambda s, a: s.z, (lay.n_control,)),
+            "acceleration": stack(lambda s, a: a.total, (lay.n_dof,)),
+            "constraint_acceleration": stack(lambda s, a: a.constraint, (lay.n_dof,)),
+            "constraint_force": stack(lambda s, a: a.constraint_force, (lay.n_dof,)),
+            "control_force": stack(lambda s, a: a.control_force, (lay.n_dof,)),
+            "unmodeled_force": stack(lambda s, a: a.unmodeled_force, (lay.n_dof,)),
+            "multipliers": stack(lambda s, a: a.multipliers, (n_mult,)),
+            "residual": np.array([a.residual for _, a in rows], dtype=float),
+            "rank": np.array([-1 if a.rank is None else a.rank for _, a in rows], dtype=np.int64),
+        }
+
+    def build(self, status: str, message: str, stats: dict[str, Any]) -> Trajectory:
+        lay = self.p.layout
+        blocks = [*self.blocks, self._columns(self.rows)]
+        if self.prefix is not None:
+            blocks.insert(0, {name: getattr(self.prefix, name) for name in _ARRAYS})
+        blocks = [blk for blk in blocks if blk["t"].size] or blocks[-1:]
+        if len({blk["multipliers"].shape[1] for blk in blocks}) > 1:
+            raise GmukError("the number of constraint rows changed during the run")
+        joined = {name: np.concatenate([blk[name] for blk in blocks]) for name in _ARRAYS}
+        return Trajectory(
+            **joined,
             body_names=lay.names,
             body_kinds=lay.kinds,
             body_dofs=lay.dofs,
@@ -234,13 +254,6 @@ class _Recorder:
             message=message,
             stats=stats,
         )
-        if self.prefix is None:
-            return traj
-        joined: dict[str, Any] = {
-            name: np.concatenate([getattr(self.prefix, name), getattr(traj, name)])
-            for name in _ARRAYS
-        }
-        return dataclasses.replace(traj, **joined)
 
 
 class _Progress:
@@ -284,6 +297,7 @@ def simulate(
     max_steps: int = 1_000_000,
     progress: bool | None = None,
     on_failure: str = "raise",
+    compiled: bool | None = None,
 ) -> Trajectory:
     """Integrate a System on SE(3)ⁿ × Rᵏ from ``state0`` over ``t_span``.
 
@@ -326,6 +340,18 @@ def simulate(
         so far as ``.trajectory`` (default), or return that trajectory with
         ``status="failed"`` and the reason in ``message``. A KeyboardInterrupt always returns
         the trajectory so far with ``status="interrupted"`` (and a warning).
+    compiled : bool, optional
+        Run the step loop compiled (:mod:`gmuk.integrators._compiled`): None (default) when
+        the System qualifies — no constraints or controllers, rigid bodies and point masses
+        only, every force model a built-in one with a compiled form (point-mass, Eq. 23 and
+        uniform gravity, the linear spring–damper, spherical harmonics on point masses) —
+        and the method is DOP853 or a plain tableau; True requires it (a
+        :class:`~gmuk.errors.DefinitionError` says why a System does not qualify); False
+        always runs the Python loop. Both loops take the same steps and give the same
+        results to rounding; ``stats["compiled"]`` says which ran. A failure inside the
+        compiled loop (a field evaluated inside the body, a NaN, a step-size underflow) is
+        retried by the Python loop from the last accepted step, which raises the error it
+        always raises, with the trajectory up to there.
 
     Returns
     -------
@@ -396,6 +422,13 @@ def simulate(
         raise DefinitionError(f"max_steps must be an integer >= 1; got {max_steps!r}")
     if progress is not None and not isinstance(progress, (bool, np.bool_)):
         raise DefinitionError(f"progress must be True, False or None; got {progress!r}")
+    if compiled is not None and not isinstance(compiled, (bool, np.bool_)):
+        raise DefinitionError(f"compiled must be True, False or None; got {compiled!r}")
+    plan: _compiled.Program | str = "not asked for"
+    if compiled is None or compiled:
+        plan = _compiled.program(system, m)
+        if compiled and isinstance(plan, str):
+            raise DefinitionError(f"this System cannot run compiled: {plan}")
 
     state0 = state0.replace(t=t0)
     control = runs.current()
@@ -420,7 +453,11 @@ def simulate(
                 return prefix
     prob = _Problem(system)
     rec = _Recorder(prob, prefix)
-    stepper = _Stepper(prob, m, rtol, atol, step, first_step, max_step)
+    stepper = (
+        _Stepper(prob, m, rtol, atol, step, first_step, max_step)
+        if isinstance(plan, str)
+        else _CompiledStepper(prob, m, rtol, atol, step, first_step, max_step, plan)
+    )
     stepper.control, stepper.checkpoint = control, checkpoint
     stepper.fingerprint, stepper.recorder = fingerprint, rec
     bar = _Progress(progress, t0, t1)
@@ -550,6 +587,7 @@ class _Stepper:
             "method": label(self.method),
             "rtol": self.rtol,
             "atol": self.atol,
+            "compiled": isinstance(self, _CompiledStepper),
         }
 
     def _initial_step(self, t: float, Y: FloatArray, f0: FloatArray, t_end: float) -> float:
@@ -682,3 +720,195 @@ class _Stepper:
             self.at = (Y, G0, h, out_i)
             bar.update(t)
             self._after_step()
+
+
+class _CompiledStepper(_Stepper):
+    """The step loop of :class:`_Stepper` run compiled (:mod:`gmuk.integrators._compiled`)
+    in chunks of steps; between chunks Python drains the outputs, updates the progress bar,
+    sees stop requests and writes checkpoints. A failure inside the compiled loop hands the
+    run to the Python loop at the last accepted step, which meets the same failure and
+    reports it as it always does."""
+
+    #: Steps per chunk: a chunk is the longest a stop request waits.
+    chunk = 256
+
+    def __init__(
+        self,
+        prob: _Problem,
+        method: RungeKuttaMethod,
+        rtol: float,
+        atol: float,
+        step: float | None,
+        first_step: float | None,
+        max_step: float,
+        program: _compiled.Program,
+    ) -> None:
+        super().__init__(prob, method, rtol, atol, step, first_step, max_step)
+        self.program = program
+
+    def _block(self, n_out: int, bufs: tuple[FloatArray, ...], acc0: Accelerations) -> dict:
+        """The first ``n_out`` buffered outputs as Trajectory columns."""
+        bt, bY, bG, bacc, bunm = (b[:n_out] for b in bufs)
+        p = self.p
+        lay = p.layout
+        nr = lay.n_rigid
+        if nr:
+            xi = bY[:, p.s_xi].reshape(-1, 6)
+            g = _kernels.compose_exp(np.ascontiguousarray(bG).reshape(-1, 4, 4), xi)
+        else:
+            g = np.zeros((n_out * nr, 4, 4))
+        zeros = np.zeros((n_out, lay.n_dof))
+        return {
+            "t": bt.copy(),
+            "g_NB": g.reshape(n_out, nr, 4, 4),
+            "V_B": bY[:, p.s_V].reshape(n_out, nr, 6).copy(),
+            "x": bY[:, p.s_x].copy(),
+            "xdot": bY[:, p.s_xd].copy(),
+            "z": np.zeros((n_out, 0)),
+            "acceleration": bacc.copy(),
+            "constraint_acceleration": zeros,
+            "constraint_force": zeros,
+            "control_force": zeros,
+            "unmodeled_force": bunm.copy(),
+            "multipliers": np.zeros((n_out, 0)),
+            "residual": np.full(n_out, float(acc0.residual)),
+            "rank": np.full(n_out, -1 if acc0.rank is None else acc0.rank, dtype=np.int64),
+        }
+
+    def run(
+        self,
+        state0: State,
+        t_end: float,
+        outs: FloatArray | None,
+        rec: _Recorder,
+        max_steps: int,
+        bar: _Progress,
+        resume: dict[str, Any] | None = None,
+    ) -> None:
+        p, m, prog = self.p, self.method, self.program
+        n, n_dof = p.size, p.layout.n_dof
+        ints = np.zeros(9, dtype=np.int64)
+        h = 0.0
+        if resume is not None:
+            t = float(resume["t"])
+            G0 = np.array(resume["G0"], dtype=float).reshape(state0.g.shape)
+            Y = np.array(resume["Y"], dtype=float)
+            if Y.shape != (n,):
+                raise runs.CheckpointError(f"checkpoint state has {Y.size} entries; expected {n}")
+            ints[_compiled.I_RHS] = int(resume.get("n_rhs", 0))
+            ints[_compiled.I_STEPS] = int(resume.get("n_steps", 0))
+            ints[_compiled.I_REJECTED] = int(resume.get("n_rejected", 0))
+            ints[_compiled.I_OUT] = int(resume["out_i"])
+            h = float(resume["h"])
+        else:
+            t = state0.t
+            G0 = state0.g.copy()
+            Y = p.pack(state0)
+            if self.control is not None and self.control.stop_requested:
+                rec.add(state0)
+                raise _StopRequested
+        self.t = t
+        p.G0 = G0
+        # the accelerations at the start, in Python: the constant residual and rank of an
+        # unconstrained solve, and the first output row exactly as the Python loop makes it
+        acc0 = self.p.system._accelerations(p.state(t, Y, G0))
+        f0, acc, unm = np.empty(n), np.empty(n_dof), np.empty(n_dof)
+        ints[_compiled.I_RHS] += 1
+        fs = np.array([t, 0.0, t_end, self.rtol, self.atol, self.max_step, 0.0])
+        status = _compiled.rhs(t, Y, G0, prog.parts, f0, acc, unm)
+        if resume is None and status == 0:
+            if outs is None or outs[0] == t:
+                rec.add(state0, acc0)
+                ints[_compiled.I_OUT] = 0 if outs is None else 1
+            if not m.adaptive:
+                h = float(self.fixed or 0)
+            else:
+                h = _compiled.initial_step(
+                    t, Y, G0, f0, t_end, self.first_step or 0.0, self.max_step, m.order,
+                    prog.parts, fs, ints,
+                )  # fmt: skip
+                status = 0 if h > 0 else -1
+        p.n_rhs = int(ints[_compiled.I_RHS])
+        if status != 0:
+            self._hand_over(state0, t_end, Y, G0, h, ints, outs, rec, max_steps, bar, resume)
+            return
+        out_arr = np.zeros(0) if outs is None else outs
+        cap = self.chunk + 1
+        bufs = self._buffers(cap, n, G0.shape[0], n_dof)
+        ints[_compiled.I_MAX_STEPS] = max_steps
+        ints[_compiled.I_CHUNK] = self.chunk
+        fs[_compiled.F_H] = h
+        self.at = (Y.copy(), G0.copy(), h, int(ints[_compiled.I_OUT]))
+        while True:
+            fs[_compiled.F_T] = t
+            ints[_compiled.I_WRITTEN] = 0
+            status = _compiled.advance(
+                prog.parts, prog.method, fs, ints, Y, G0, f0, acc, unm,
+                out_arr, outs is not None, *bufs,
+            )  # fmt: skip
+            n_out = int(ints[_compiled.I_WRITTEN])
+            if n_out:
+                rec.add_block(self._block(n_out, bufs, acc0))
+            t, h = float(fs[_compiled.F_T]), float(fs[_compiled.F_H])
+            self.t = t
+            p.G0 = G0
+            p.n_rhs = int(ints[_compiled.I_RHS])
+            self.n_steps = int(ints[_compiled.I_STEPS])
+            self.n_rejected = int(ints[_compiled.I_REJECTED])
+            self.at = (Y.copy(), G0.copy(), h, int(ints[_compiled.I_OUT]))
+            bar.update(t)
+            if status == _compiled.DONE:
+                return
+            if status < 0:
+                self._hand_over(state0, t_end, Y, G0, h, ints, outs, rec, max_steps, bar, resume)
+                return
+            if status == _compiled.FULL and n_out == 0:  # one step has more outputs than room
+                cap = 2 * int(ints[_compiled.I_NEED]) + cap
+                bufs = self._buffers(cap, n, G0.shape[0], n_dof)
+            self._after_step()
+
+    @staticmethod
+    def _buffers(cap: int, n: int, nr: int, n_dof: int) -> tuple[FloatArray, ...]:
+        return (
+            np.empty(cap),
+            np.empty((cap, n)),
+            np.empty((cap, nr, 4, 4)),
+            np.empty((cap, n_dof)),
+            np.empty((cap, n_dof)),
+        )
+
+    def _hand_over(
+        self,
+        state0: State,
+        t_end: float,
+        Y: FloatArray,
+        G0: FloatArray,
+        h: float,
+        ints: np.ndarray,
+        outs: FloatArray | None,
+        rec: _Recorder,
+        max_steps: int,
+        bar: _Progress,
+        resume: dict[str, Any] | None,
+    ) -> None:
+        """Continue in the Python loop from the last accepted step (after a failure), or
+        from the start when the compiled loop failed before its first step."""
+        if resume is None and ints[_compiled.I_STEPS] == 0:
+            rec.rows.clear()
+            rec.blocks.clear()
+            self.p.n_rhs = 0
+            _Stepper.run(self, state0, t_end, outs, rec, max_steps, bar)
+            return
+        record = resume or {}
+        if ints[_compiled.I_STEPS] > int(record.get("n_steps", -1)):
+            record = {
+                "t": self.t,
+                "G0": G0.ravel().tolist(),
+                "Y": Y.tolist(),
+                "n_rhs": int(ints[_compiled.I_RHS]),
+                "n_steps": int(ints[_compiled.I_STEPS]),
+                "n_rejected": int(ints[_compiled.I_REJECTED]),
+                "out_i": int(ints[_compiled.I_OUT]),
+                "h": h,
+            }
+        _Stepper.run(self, state0, t_end, outs, rec, max_steps, bar, resume=record)

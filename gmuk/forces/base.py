@@ -139,6 +139,19 @@ class ForceModel(FreezesInSystem):
         """
         raise DefinitionError(f"{self.name} does not act on point masses")
 
+    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
+        """How the compiled step loop evaluates this model on ``body``: (code of
+        :mod:`gmuk.forces._kernels`, parameters, field data vector or None), or None when
+        the model has no compiled form and is called in Python. Built-in models return their
+        term only when their ``force``/``wrench``/``wrenches`` are not overridden."""
+        return None
+
+    def _methods_are(self, cls: type) -> bool:
+        """Whether this object's wrench, force and wrenches are those of ``cls`` (a
+        subclass that overrides any of them gets no compiled term)."""
+        t = type(self)
+        return all(getattr(t, k) is getattr(cls, k) for k in ("wrench", "force", "wrenches"))
+
     def wrenches(self, state: State, bodies: Sequence[Body]) -> list[FloatArray]:
         """Wrenches on each of ``bodies`` at ``state``: [L; f] (6,) in B per rigid body,
         f_N (3,) per point mass (and (dof,) per other Euclidean body)."""

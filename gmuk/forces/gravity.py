@@ -23,10 +23,11 @@ import numpy as np
 
 from gmuk._validation import FloatArray, real_number
 from gmuk.bodies import BodyKind
-from gmuk.celestial import CelestialBody
+from gmuk.celestial import CelestialBody, UniformRotation
 from gmuk.errors import DefinitionError
 from gmuk.forces import _kernels
 from gmuk.forces.base import ForceModel
+from gmuk.gravity.field import SphericalHarmonicField
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
@@ -64,6 +65,11 @@ class PointMassGravity(ForceModel):
         """``−μ m r_N/|r_N|³`` (N)."""
         rn = float(np.sqrt(r_N @ r_N))
         return (-self.mu * body.mass / rn**3) * r_N
+
+    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
+        if not self._methods_are(PointMassGravity):
+            return None
+        return _kernels.POINT_MASS, (self.mu,), None
 
 
 class GravityGradient(ForceModel):
@@ -104,6 +110,11 @@ class GravityGradient(ForceModel):
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
         """The point-mass force ``−μ m r_N/|r_N|³`` on a particle (N)."""
         return (-self.mu * body.mass / float(np.sqrt(r_N @ r_N)) ** 3) * r_N
+
+    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
+        if not self._methods_are(GravityGradient):
+            return None
+        return _kernels.GRAVITY_GRADIENT, (self.mu,), None
 
 
 def _shipped_body(name: str, degree: int | None) -> CelestialBody:
@@ -215,6 +226,21 @@ class SphericalHarmonicGravity(ForceModel):
         """m ∇U at r_N, in N (N)."""
         R_FN = self.central_body.rotation.R_FN(t)
         return body.mass * (R_FN.T @ self.field.acceleration(R_FN @ r_N))
+
+    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
+        """Point masses in a field with a compiled kernel, the central body spinning
+        uniformly (:class:`~gmuk.celestial.UniformRotation`); None otherwise."""
+        rot = self.central_body.rotation
+        data = getattr(self.field, "_data", None)
+        if (
+            body.kind is not BodyKind.POINT
+            or not self._methods_are(SphericalHarmonicGravity)
+            or type(rot) is not UniformRotation
+            or type(self.field) is not SphericalHarmonicField
+            or data is None
+        ):
+            return None
+        return _kernels.HARMONIC_POINT, (float(rot.angle0), float(rot.rate)), data
 
     def finite_size_force(self, t: float, g_NB: FloatArray, body: RigidBody) -> FloatArray:
         """The second-order finite-size force ``½ ∇³U : Π`` alone, in the body frame (N).

@@ -10,6 +10,7 @@ import numpy as np
 from gmuk._validation import FloatArray, as_array, real_number
 from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError, GmukError
+from gmuk.forces import _kernels
 from gmuk.forces.base import ForceModel
 
 if TYPE_CHECKING:
@@ -116,6 +117,11 @@ class UniformGravity(ForceModel):
         """m g_N (N)."""
         return body.mass * self.g_N
 
+    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
+        if not self._methods_are(UniformGravity):
+            return None
+        return _kernels.UNIFORM, tuple(float(v) for v in self.g_N), None
+
 
 class LinearSpringDamper(ForceModel):
     """A linear spring and damper from a fixed anchor: ``f_N = −k (r_N − r_a) − c v_N``.
@@ -163,6 +169,11 @@ class LinearSpringDamper(ForceModel):
         R = g_NB[:3, :3]
         f_N = -self.k * (g_NB[:3, 3] - self.anchor) - self.c * (R @ V_B[3:])
         return np.concatenate([np.zeros(3), R.T @ f_N])
+
+    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
+        if not self._methods_are(LinearSpringDamper):
+            return None
+        return _kernels.SPRING, (self.k, self.c, *(float(v) for v in self.anchor)), None
 
 
 class SlackDamping(ForceModel):

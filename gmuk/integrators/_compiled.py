@@ -1,0 +1,634 @@
+"""The compiled step loop: the RKMK integrator of :mod:`gmuk.integrate`, run in machine code
+for a System whose parts all have compiled forms.
+
+A System qualifies when it has no constraints and no controllers, its bodies are rigid bodies
+and point masses, and each of its force models gives a compiled term for each of its bodies
+(``ForceModel._compiled_term``: the built-in gravity, uniform-gravity and linear spring–damper
+models, unless a subclass overrides their methods). The method must be one whose step is its
+tableau (every :class:`~gmuk.integrators.RungeKuttaMethod` that keeps the base class's
+``stages``, ``error_norm`` and has no continuous extension of its own) or DOP853 itself.
+:func:`program` derives the compiled form from the parts once per call of ``simulate``; the
+parts stay the objects the user built.
+
+The loop is the Python loop of :class:`gmuk.integrate._Stepper` statement for statement (step
+control, landing on output times, the continuous extension and its error control, the base
+pose update with its Newton–Schulz step, the reuse of the last evaluation's accelerations at
+the step end). It runs a chunk of steps and returns, so that Python can see stop requests,
+write checkpoints and drain the output buffers between chunks; the results agree with the
+Python loop's to rounding (sums in another order), which the tests check on every built-in
+part.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gmuk._numba import njit
+from gmuk._uk_kernels import rigid_free_accel
+from gmuk.bodies import BodyKind
+from gmuk.forces._kernels import apply_term
+from gmuk.integrators import _dop853_tableau as _tab
+from gmuk.integrators._base import RungeKuttaMethod
+from gmuk.integrators.dop853 import DOP853
+from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
+
+if TYPE_CHECKING:
+    from gmuk.system import System
+
+__all__ = ["Program", "program"]
+
+# Status codes of :func:`advance`.
+DONE = 0  #: reached the end time
+PAUSE = 1  #: ran its chunk of steps
+FULL = 2  #: the output buffers have no room for the next step's outputs
+NONFINITE = -1  #: a derivative with NaN or inf
+UNDERFLOW = -2  #: step size underflow
+MAX_STEPS = -3  #: max_steps reached
+FIELD = -4  #: a force kernel's failure (its status in ints[I_FIELD])
+
+# Entries of the integer and float state vectors shared with Python.
+I_OUT, I_STEPS, I_REJECTED, I_RHS, I_WRITTEN, I_MAX_STEPS, I_CHUNK, I_FIELD, I_NEED = range(9)
+F_T, F_H, F_END, F_RTOL, F_ATOL, F_MAX_STEP, F_BAD_T = range(7)
+
+
+@dataclass(frozen=True)
+class Program:
+    """The compiled form of a System and a method (see the module docstring).
+
+    ``parts`` is the tuple the kernels take: (terms (n_terms, 8) int64 — code, rigid, body
+    index, ν offset, modeled, parameter start, field start, field end —, parameters, field
+    data, J (n_r, 3, 3), J⁻¹, rigid masses, Euclidean masses per entry, rigid ν offsets,
+    Euclidean ν offsets, dims [n_r, n_e, n_dof, plant-only loads]). ``method`` is (A, b, c,
+    E, E3, A_ext, c_ext, D, ints [s, rows, fsal, adaptive, order, dop853, dense]).
+    """
+
+    parts: tuple[Any, ...]
+    method: tuple[Any, ...]
+    n: int
+
+
+def _generic(method: RungeKuttaMethod) -> bool:
+    cls = type(method)
+    return (
+        cls.stages is RungeKuttaMethod.stages
+        and cls.error_norm is RungeKuttaMethod.error_norm
+        and not method.dense_output
+    )
+
+
+def program(system: System, method: RungeKuttaMethod) -> Program | str:
+    """The compiled form of ``system`` with ``method``, or why there is none (a sentence)."""
+    from gmuk.system import System
+
+    if type(system).accelerations is not System.accelerations:
+        return "the System subclass overrides accelerations"
+    if type(system.solver).__module__ != "gmuk.solvers":
+        return f"the solve strategy {type(system.solver).__name__} is not a built-in one"
+    if system.constraints:
+        return "the System has constraints"
+    if system.controllers:
+        return "the System has controllers"
+    lay = system.layout
+    bad = [b.name for b in system.bodies if b.kind not in (BodyKind.RIGID, BodyKind.POINT)]
+    if bad:
+        return f"bodies {bad} are neither rigid bodies nor point masses"
+    dop853 = type(method) is DOP853
+    if not dop853 and not _generic(method):
+        return f"the method {type(method).__name__} defines its own step or output"
+    terms: list[list[int]] = []
+    params: list[float] = []
+    fields: list[np.ndarray] = []
+    field_at: dict[int, tuple[int, int]] = {}
+    n_field = 0
+    for f, _bodies, slots in system._force_plan:
+        if slots is None:
+            return f"force model {f.name!r} couples bodies (wrenches)"
+        for body, rigid, index, offset, _dof in slots:
+            term = f._compiled_term(body)
+            if term is None:
+                return f"force model {f.name!r} has no compiled form on body {body.name!r}"
+            code, values, data = term
+            f0 = f1 = 0
+            if data is not None:
+                if id(data) not in field_at:
+                    field_at[id(data)] = (n_field, n_field + data.size)
+                    fields.append(np.asarray(data, dtype=float))
+                    n_field += data.size
+                f0, f1 = field_at[id(data)]
+            terms.append([code, int(rigid), index, offset, int(f.modeled), len(params), f0, f1])
+            params.extend(float(v) for v in values)
+    nr, ne = lay.n_rigid, lay.n_euclid
+    parts = (
+        np.array(terms, dtype=np.int64).reshape(-1, 8),
+        np.array([*params, 0.0], dtype=float),
+        np.concatenate(fields) if fields else np.zeros(1),
+        np.ascontiguousarray(system._J, dtype=float).reshape(nr, 3, 3),
+        np.ascontiguousarray(system._Jinv, dtype=float).reshape(nr, 3, 3),
+        np.ascontiguousarray(system._m_rigid, dtype=float).reshape(nr),
+        np.ascontiguousarray(system._m_euclid, dtype=float).reshape(ne),
+        np.asarray(lay.rigid_offsets, dtype=np.int64),
+        np.asarray(lay.euclid_offsets, dtype=np.int64),
+        np.array([nr, ne, lay.n_dof, int(system._plant_only_loads)], dtype=np.int64),
+    )
+    s = method.n_stages
+    E = np.zeros(method._n_rows) if method.E is None else np.asarray(method.E, dtype=float)
+    ints = np.array(
+        [
+            s,
+            method._n_rows,
+            int(method.fsal),
+            int(method.adaptive),
+            method.order,
+            int(dop853),
+            int(method.dense_output),
+        ],
+        dtype=np.int64,
+    )
+    meth = (
+        np.ascontiguousarray(method.A, dtype=float),
+        np.ascontiguousarray(method.b, dtype=float),
+        np.ascontiguousarray(method.c, dtype=float),
+        np.ascontiguousarray(E),
+        np.ascontiguousarray(_tab.E3 if dop853 else np.zeros(method._n_rows)),
+        np.ascontiguousarray(_tab.A),
+        np.ascontiguousarray(_tab.C),
+        np.ascontiguousarray(_tab.D),
+        ints,
+    )
+    return Program(parts, meth, 12 * nr + 2 * ne)
+
+
+# ------------------------------------------------------------------------ right-hand side
+@njit(cache=True)
+def rhs(t, Y, G0, parts, dY, total, unmodeled):  # type: ignore[no-untyped-def]
+    """dY/dt at (t, Y) about the base poses G0 into ``dY``; the total acceleration (n_dof,)
+    into ``total`` and the unmodeled generalized forces into ``unmodeled``. Returns 0, the
+    negated status of a failed force kernel (< 0 − 100), or NONFINITE."""
+    terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims = parts
+    nr, ne, ndof, plant = dims[0], dims[1], dims[2], dims[3]
+    xi = np.empty((nr, 6))
+    V = np.empty((nr, 6))
+    any_xi = False
+    for k in range(nr):
+        for i in range(6):
+            xi[k, i] = Y[6 * k + i]
+            V[k, i] = Y[6 * nr + 6 * k + i]
+            if xi[k, i] != 0.0:
+                any_xi = True
+    g = np.empty((nr, 4, 4))
+    if nr:
+        _compose_exp_into(G0, xi, g)
+    modeled = np.zeros(ndof)
+    unmodeled[:] = 0.0
+    w = np.empty(6)
+    gp = np.zeros((4, 4))
+    vp = np.zeros(6)
+    no_inertia = np.zeros((3, 3))
+    x0 = 12 * nr
+    for f in range(terms.shape[0]):
+        code, rig, idx, off = terms[f, 0], terms[f, 1], terms[f, 2], terms[f, 3]
+        p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]
+        if rig:
+            status = apply_term(
+                code, True, t, g[idx], V[idx], m_r[idx], J[idx], params[p0:], fdata[f0:f1], w
+            )
+            dof = 6
+        else:
+            for i in range(3):
+                gp[i, 3] = Y[x0 + idx + i]
+                vp[i] = Y[x0 + ne + idx + i]
+            status = apply_term(
+                code, False, t, gp, vp, m_e[idx], no_inertia, params[p0:], fdata[f0:f1], w
+            )
+            dof = 3
+        if status != 0:
+            return -100 - status
+        if terms[f, 4]:
+            for i in range(dof):
+                modeled[off + i] += w[i]
+        else:
+            for i in range(dof):
+                unmodeled[off + i] += w[i]
+    # ν̇_a = M⁻¹(ad*_V 𝕀V + Q): Eq. 10b for rigid bodies, Q/m for point masses
+    if nr:
+        Q = np.empty((nr, 6))
+        for k in range(nr):
+            for i in range(6):
+                Q[k, i] = modeled[r_off[k] + i]
+        a_r = rigid_free_accel(V, J, Jinv, m_r, Q)
+        for k in range(nr):
+            for i in range(6):
+                total[r_off[k] + i] = a_r[k, i]
+    for i in range(ne):
+        total[e_off[i]] = modeled[e_off[i]] / m_e[i]
+    if plant:  # unmodeled loads act on the plant: + M⁻¹ Q_u
+        for k in range(nr):
+            o = r_off[k]
+            for i in range(3):
+                total[o + i] += (
+                    Jinv[k, i, 0] * unmodeled[o]
+                    + Jinv[k, i, 1] * unmodeled[o + 1]
+                    + Jinv[k, i, 2] * unmodeled[o + 2]
+                )
+                total[o + 3 + i] += unmodeled[o + 3 + i] / m_r[k]
+        for i in range(ne):
+            total[e_off[i]] += unmodeled[e_off[i]] / m_e[i]
+    # dY = [dexp⁻¹(ξ) V, V̇, ẋ, ẍ]
+    if nr:
+        if any_xi:
+            xd = np.empty((nr, 6))
+            _dexp_inv_apply_into(xi, V, xd)
+            for k in range(nr):
+                for i in range(6):
+                    dY[6 * k + i] = xd[k, i]
+        else:
+            for i in range(6 * nr):
+                dY[i] = Y[6 * nr + i]
+        for k in range(nr):
+            for i in range(6):
+                dY[6 * nr + 6 * k + i] = total[r_off[k] + i]
+    for i in range(ne):
+        dY[x0 + i] = Y[x0 + ne + i]
+        dY[x0 + ne + i] = total[e_off[i]]
+    for i in range(dY.shape[0]):
+        if not math.isfinite(dY[i]):
+            return NONFINITE
+    return 0
+
+
+@njit(cache=True)
+def _scale(Y0, Y1, G0, nr, ne, rtol, atol, sc):  # type: ignore[no-untyped-def]
+    """The error weights of :meth:`gmuk.integrate._Problem.scale`."""
+    for i in range(Y0.shape[0]):
+        sc[i] = atol + rtol * max(abs(Y0[i]), abs(Y1[i]))
+    for k in range(nr):
+        r = math.sqrt(G0[k, 0, 3] ** 2 + G0[k, 1, 3] ** 2 + G0[k, 2, 3] ** 2)
+        for i in range(3):
+            sc[6 * k + i] = atol + rtol
+            sc[6 * k + 3 + i] = atol + rtol * r
+        for half in range(2):
+            o = 6 * nr + 6 * k + 3 * half
+            n0 = math.sqrt(Y0[o] ** 2 + Y0[o + 1] ** 2 + Y0[o + 2] ** 2)
+            n1 = math.sqrt(Y1[o] ** 2 + Y1[o + 1] ** 2 + Y1[o + 2] ** 2)
+            w = atol + rtol * max(n0, n1)
+            sc[o] = sc[o + 1] = sc[o + 2] = w
+    # point masses: positions and velocities as 3-vectors
+    for o in range(12 * nr, 12 * nr + 2 * ne, 3):
+        n0 = math.sqrt(Y0[o] ** 2 + Y0[o + 1] ** 2 + Y0[o + 2] ** 2)
+        n1 = math.sqrt(Y1[o] ** 2 + Y1[o + 1] ** 2 + Y1[o + 2] ** 2)
+        w = atol + rtol * max(n0, n1)
+        sc[o] = sc[o + 1] = sc[o + 2] = w
+
+
+@njit(cache=True)
+def _rms(v, sc):  # type: ignore[no-untyped-def]
+    acc = 0.0
+    for i in range(v.shape[0]):
+        acc += (v[i] / sc[i]) ** 2
+    return math.sqrt(acc / v.shape[0])
+
+
+@njit(cache=True)
+def initial_step(t, Y, G0, f0, t_end, first_step, max_step, order, parts, fs, ints):  # type: ignore[no-untyped-def]
+    """:meth:`gmuk.integrate._Stepper._initial_step` (Hairer's starting step). Returns the
+    step, or a negative number on a failed evaluation (status in ints[I_FIELD])."""
+    if first_step > 0.0:
+        return min(first_step, t_end - t)
+    nr, ne, ndof = parts[9][0], parts[9][1], parts[9][2]
+    n = Y.shape[0]
+    sc = np.empty(n)
+    _scale(Y, Y, G0, nr, ne, fs[F_RTOL], fs[F_ATOL], sc)
+    d0 = _rms(Y, sc)
+    d1 = _rms(f0, sc)
+    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+    h0 = min(h0, t_end - t)
+    f1 = np.empty(n)
+    total = np.empty(ndof)
+    unm = np.empty(ndof)
+    ints[I_RHS] += 1
+    status = rhs(t + h0, Y + h0 * f0, G0, parts, f1, total, unm)
+    if status != 0:
+        ints[I_FIELD] = status
+        fs[F_BAD_T] = t + h0
+        return -1.0
+    acc = 0.0
+    for i in range(n):
+        acc += ((f1[i] - f0[i]) / sc[i]) ** 2
+    d2 = math.sqrt(acc / n) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
+    return min(100 * h0, h1, max_step, t_end - t)
+
+
+@njit(cache=True)
+def _factor(err, order):  # type: ignore[no-untyped-def]
+    return 0.9 * (max(err, 1e-10) ** (-1.0 / order))
+
+
+@njit(cache=True)
+def _interpolate(F, Y0, s, out):  # type: ignore[no-untyped-def]
+    """DOP853's continuous extension u(s) into ``out`` (gmuk.integrators.dop853)."""
+    n = Y0.shape[0]
+    p = F.shape[0]
+    acc = np.zeros(n)
+    for i in range(p):
+        fac = s if i % 2 == 0 else 1.0 - s
+        for j in range(n):
+            acc[j] = (acc[j] + F[p - 1 - i, j]) * fac
+    for j in range(n):
+        out[j] = Y0[j] + acc[j]
+
+
+@njit(cache=True)
+def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, bG, bacc, bunm):  # type: ignore[no-untyped-def]
+    """Run steps from (fs[F_T], Y, G0) with f0 = f(t, Y) and the accelerations ``acc`` /
+    ``unm`` of that evaluation, until the end time, ``ints[I_CHUNK]`` steps, full output
+    buffers or a failure; returns the status (module constants). Y, G0, f0, acc, unm, fs and
+    ints are updated in place to the last accepted step; outputs are appended to the buffers
+    (bt, bY, bG, bacc, bunm) from ints[I_WRITTEN]."""
+    A, b, c, E, E3, Ax, Cx, D, mi = meth
+    s, n_rows, fsal, adaptive, order, dop853, dense = (
+        mi[0],
+        mi[1],
+        mi[2],
+        mi[3],
+        mi[4],
+        mi[5],
+        mi[6],
+    )
+    dims = parts[9]
+    nr, ne, ndof = dims[0], dims[1], dims[2]
+    n = Y.shape[0]
+    t, h, t_end = fs[F_T], fs[F_H], fs[F_END]
+    rtol, atol, max_step = fs[F_RTOL], fs[F_ATOL], fs[F_MAX_STEP]
+    out_i = ints[I_OUT]
+    n_outs = outs.shape[0]
+    cap = bt.shape[0]
+    step_to_outputs = (not dense) and has_outs
+    use_dense = dense and has_outs
+    eps = np.finfo(np.float64).eps
+    K = np.empty((n_rows, n))
+    Kx = np.empty((_tab.N_STAGES_EXTENDED, n))
+    F = np.empty((_tab.INTERPOLATOR_POWER, n))
+    Yt = np.empty(n)
+    Y1 = np.empty(n)
+    f1 = np.empty(n)
+    sc = np.empty(n)
+    acc1 = np.empty(ndof)
+    unm1 = np.empty(ndof)
+    tmp_acc = np.empty(ndof)
+    tmp_unm = np.empty(ndof)
+    G1 = np.empty((nr, 4, 4))
+    R = np.empty((3, 3))
+    RtR = np.empty((3, 3))
+    u = np.empty(n)
+    du = np.empty(n)
+    ddy = np.empty(n)
+    steps_here = 0
+    status = DONE
+    while t < t_end:
+        if ints[I_STEPS] >= ints[I_MAX_STEPS]:
+            status = MAX_STEPS
+            break
+        if steps_here >= ints[I_CHUNK]:
+            status = PAUSE
+            break
+        h = min(h, max_step)
+        t_target = t_end
+        if step_to_outputs and out_i < n_outs:
+            t_target = min(t_end, outs[out_i])
+        landing = t_target - t <= h * (1.0 + 1e-6)
+        h_try = t_target - t if landing else h
+        if h_try <= 10 * eps * max(1.0, abs(t)):
+            status = UNDERFLOW
+            fs[F_H] = h_try
+            break
+        # room for this step's outputs
+        need = 1
+        if use_dense:
+            j = out_i
+            while j < n_outs and outs[j] <= t + h_try:
+                need += 1
+                j += 1
+        if ints[I_WRITTEN] + need > cap:
+            ints[I_NEED] = need
+            status = FULL
+            break
+        # stages
+        for j in range(n):
+            K[0, j] = f0[j]
+        bad = 0
+        for i in range(1, s):
+            for j in range(n):
+                q = 0.0
+                for m in range(i):
+                    q += A[i, m] * K[m, j]
+                Yt[j] = Y[j] + h_try * q
+            ints[I_RHS] += 1
+            bad = rhs(t + c[i] * h_try, Yt, G0, parts, K[i], tmp_acc, tmp_unm)
+            if bad != 0:
+                fs[F_BAD_T] = t + c[i] * h_try
+                break
+        if bad != 0:
+            status = bad if bad == NONFINITE else FIELD
+            ints[I_FIELD] = bad
+            break
+        for j in range(n):
+            q = 0.0
+            for i in range(s):
+                q += b[i] * K[i, j]
+            Y1[j] = Y[j] + h_try * q
+        ints[I_RHS] += 1
+        bad = rhs(t + h_try, Y1, G0, parts, f1, acc1, unm1)
+        if bad != 0:
+            fs[F_BAD_T] = t + h_try
+            status = bad if bad == NONFINITE else FIELD
+            ints[I_FIELD] = bad
+            break
+        if fsal:
+            for j in range(n):
+                K[n_rows - 1, j] = f1[j]
+        h_next = h
+        if adaptive:
+            _scale(Y, Y1, G0, nr, ne, rtol, atol, sc)
+            if dop853:
+                n5 = 0.0
+                n3 = 0.0
+                for j in range(n):
+                    e5 = 0.0
+                    e3 = 0.0
+                    for i in range(n_rows):
+                        e5 += K[i, j] * E[i]
+                        e3 += K[i, j] * E3[i]
+                    n5 += (e5 / sc[j]) ** 2
+                    n3 += (e3 / sc[j]) ** 2
+                err = 0.0
+                if n5 != 0.0 or n3 != 0.0:
+                    err = abs(h_try) * n5 / math.sqrt((n5 + 0.01 * n3) * n)
+            else:
+                acc2 = 0.0
+                for j in range(n):
+                    e = 0.0
+                    for i in range(n_rows):
+                        e += K[i, j] * E[i]
+                    acc2 += (h_try * e / sc[j]) ** 2
+                err = math.sqrt(acc2 / n)
+            factor = _factor(err, order)
+            if err > 1.0:
+                ints[I_REJECTED] += 1
+                h = h_try * max(0.2, min(0.9, factor))
+                continue
+            h_next = h_try * min(10.0, max(0.2, factor))
+        t_new = t_target if landing else t + h_try
+        if use_dense and out_i < n_outs and outs[out_i] < t_new:
+            # DOP853's continuous extension: three more stages
+            ne_rows = _tab.N_STAGES + 1
+            for i in range(ne_rows):
+                for j in range(n):
+                    Kx[i, j] = K[i, j]
+            for i in range(ne_rows, _tab.N_STAGES_EXTENDED):
+                for j in range(n):
+                    q = 0.0
+                    for m in range(i):
+                        q += Ax[i, m] * Kx[m, j]
+                    Yt[j] = Y[j] + h_try * q
+                ints[I_RHS] += 1
+                bad = rhs(t + Cx[i] * h_try, Yt, G0, parts, Kx[i], tmp_acc, tmp_unm)
+                if bad != 0:
+                    fs[F_BAD_T] = t + Cx[i] * h_try
+                    break
+            if bad != 0:
+                status = bad if bad == NONFINITE else FIELD
+                ints[I_FIELD] = bad
+                break
+            last = _tab.N_STAGES
+            for j in range(n):
+                dy = Y1[j] - Y[j]
+                F[0, j] = dy
+                F[1, j] = h_try * K[0, j] - dy
+                F[2, j] = 2.0 * dy - h_try * (K[last, j] + K[0, j])
+            for r in range(D.shape[0]):
+                for j in range(n):
+                    q = 0.0
+                    for m in range(_tab.N_STAGES_EXTENDED):
+                        q += D[r, m] * Kx[m, j]
+                    F[3 + r, j] = h_try * q
+            if adaptive:
+                # the extension's error from its defect at s* = 0.95 (DOP853.interpolant_error)
+                s_star = 0.95
+                p = F.shape[0]
+                for j in range(n):
+                    u[j] = 0.0
+                    du[j] = 0.0
+                for i in range(p):
+                    for j in range(n):
+                        qq = u[j] + F[p - 1 - i, j]
+                        if i % 2 == 0:
+                            u[j], du[j] = qq * s_star, du[j] * s_star + qq
+                        else:
+                            u[j], du[j] = qq * (1.0 - s_star), du[j] * (1.0 - s_star) - qq
+                for j in range(n):
+                    u[j] += Y[j]
+                ints[I_RHS] += 1
+                bad = rhs(t + s_star * h_try, u, G0, parts, ddy, tmp_acc, tmp_unm)
+                if bad != 0:
+                    fs[F_BAD_T] = t + s_star * h_try
+                    status = bad if bad == NONFINITE else FIELD
+                    ints[I_FIELD] = bad
+                    break
+                acc2 = 0.0
+                for j in range(n):
+                    acc2 += ((h_try * ddy[j] - du[j]) / sc[j]) ** 2
+                err_d = 0.18 * math.sqrt(acc2 / n)
+                factor_d = _factor(err_d, order)
+                if err_d > 1.0:
+                    ints[I_REJECTED] += 1
+                    h = h_try * max(0.2, min(0.9, factor_d))
+                    continue
+                h_next = min(h_next, h_try * min(10.0, max(0.2, factor_d)))
+            while out_i < n_outs and outs[out_i] < t_new:
+                tt = outs[out_i]
+                w = ints[I_WRITTEN]
+                _interpolate(F, Y, (tt - t) / h_try, bY[w])
+                bad = rhs(tt, bY[w], G0, parts, ddy, bacc[w], bunm[w])
+                if bad != 0:
+                    fs[F_BAD_T] = tt
+                    break
+                bt[w] = tt
+                for k in range(nr):
+                    bG[w, k] = G0[k]
+                ints[I_WRITTEN] = w + 1
+                out_i += 1
+            if bad != 0:
+                status = bad if bad == NONFINITE else FIELD
+                ints[I_FIELD] = bad
+                break
+        # the new base G₁ = G₀ exp(ξ₁), re-orthonormalised: R ← R(3I − RᵀR)/2
+        if nr:
+            xi1 = np.empty((nr, 6))
+            for k in range(nr):
+                for i in range(6):
+                    xi1[k, i] = Y1[6 * k + i]
+            _compose_exp_into(G0, xi1, G1)
+            for k in range(nr):
+                for i in range(3):
+                    for j in range(3):
+                        R[i, j] = G1[k, i, j]
+                for i in range(3):
+                    for j in range(3):
+                        RtR[i, j] = R[0, i] * R[0, j] + R[1, i] * R[1, j] + R[2, i] * R[2, j]
+                for i in range(3):
+                    for j in range(3):
+                        q = 0.0
+                        for m in range(3):
+                            q += R[i, m] * ((3.0 if m == j else 0.0) - RtR[m, j])
+                        G1[k, i, j] = 0.5 * q
+            for i in range(6 * nr):
+                Y1[i] = 0.0
+            for k in range(nr):
+                G0[k] = G1[k]
+        # the next step's first stage: ξ̇ = V at ξ = 0, and the same accelerations
+        for j in range(n):
+            Y[j] = Y1[j]
+        for i in range(6 * nr):
+            f0[i] = Y[6 * nr + i]
+        for k in range(nr):
+            for i in range(6):
+                f0[6 * nr + 6 * k + i] = acc1[parts[7][k] + i]
+        x0 = 12 * nr
+        for i in range(ne):
+            f0[x0 + i] = Y[x0 + ne + i]
+            f0[x0 + ne + i] = acc1[parts[8][i]]
+        for i in range(ndof):
+            acc[i] = acc1[i]
+            unm[i] = unm1[i]
+        if (not has_outs) or (out_i < n_outs and outs[out_i] == t_new):
+            w = ints[I_WRITTEN]
+            bt[w] = t_new
+            for j in range(n):
+                bY[w, j] = Y[j]
+            for k in range(nr):
+                bG[w, k] = G0[k]
+            for i in range(ndof):
+                bacc[w, i] = acc1[i]
+                bunm[w, i] = unm1[i]
+            ints[I_WRITTEN] = w + 1
+            if has_outs:
+                out_i += 1
+        t, h = t_new, h_next
+        ints[I_STEPS] += 1
+        steps_here += 1
+        fs[F_T] = t
+        fs[F_H] = h
+        ints[I_OUT] = out_i
+    fs[F_T] = t
+    if status != UNDERFLOW:
+        fs[F_H] = h
+    ints[I_OUT] = out_i
+    return status
