@@ -722,6 +722,11 @@ class _Stepper:
             self._after_step()
 
 
+#: The compiled loop's output buffers: times, states Y, base poses, total accelerations and
+#: unmodeled generalized forces, one row per output.
+_Buffers = tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
+
+
 class _CompiledStepper(_Stepper):
     """The step loop of :class:`_Stepper` run compiled (:mod:`gmuk.integrators._compiled`)
     in chunks of steps; between chunks Python drains the outputs, updates the progress bar,
@@ -746,7 +751,7 @@ class _CompiledStepper(_Stepper):
         super().__init__(prob, method, rtol, atol, step, first_step, max_step)
         self.program = program
 
-    def _block(self, n_out: int, bufs: tuple[FloatArray, ...], acc0: Accelerations) -> dict:
+    def _block(self, n_out: int, bufs: _Buffers, acc0: Accelerations) -> dict[str, Any]:
         """The first ``n_out`` buffered outputs as Trajectory columns."""
         bt, bY, bG, bacc, bunm = (b[:n_out] for b in bufs)
         p = self.p
@@ -834,7 +839,7 @@ class _CompiledStepper(_Stepper):
             return
         out_arr = np.zeros(0) if outs is None else outs
         cap = self.chunk + 1
-        bufs = self._buffers(cap, n, G0.shape[0], n_dof)
+        bufs = self._buffers(cap, n, p.layout.n_rigid, n_dof)
         ints[_compiled.I_MAX_STEPS] = max_steps
         ints[_compiled.I_CHUNK] = self.chunk
         fs[_compiled.F_H] = h
@@ -864,11 +869,11 @@ class _CompiledStepper(_Stepper):
                 return
             if status == _compiled.FULL and n_out == 0:  # one step has more outputs than room
                 cap = 2 * int(ints[_compiled.I_NEED]) + cap
-                bufs = self._buffers(cap, n, G0.shape[0], n_dof)
+                bufs = self._buffers(cap, n, p.layout.n_rigid, n_dof)
             self._after_step()
 
     @staticmethod
-    def _buffers(cap: int, n: int, nr: int, n_dof: int) -> tuple[FloatArray, ...]:
+    def _buffers(cap: int, n: int, nr: int, n_dof: int) -> _Buffers:
         return (
             np.empty(cap),
             np.empty((cap, n)),
