@@ -31,6 +31,7 @@ from gmuk._numba import njit
 from gmuk._uk_kernels import rigid_free_accel
 from gmuk.bodies import BodyKind
 from gmuk.forces._kernels import apply_term
+from gmuk.gravity import _kernels as _field_kernels
 from gmuk.integrators import _dop853_tableau as _tab
 from gmuk.integrators._base import RungeKuttaMethod
 from gmuk.integrators.dop853 import DOP853
@@ -122,10 +123,16 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
             terms.append([code, int(rigid), index, offset, int(f.modeled), len(params), f0, f1])
             params.extend(float(v) for v in values)
     nr, ne = lay.n_rigid, lay.n_euclid
+    field_data = np.concatenate(fields) if fields else np.zeros(1)
+    field_data.setflags(write=False)
+    # The force kernels call the field kernel's one compiled signature (read-only data):
+    # resolving it here loads it (or compiles it once) and keeps the loop from compiling
+    # a second copy for other argument types.
+    _field_kernels.ENTRIES.acceleration_at  # noqa: B018
     parts = (
         np.array(terms, dtype=np.int64).reshape(-1, 8),
         np.array([*params, 0.0], dtype=float),
-        np.concatenate(fields) if fields else np.zeros(1),
+        field_data,
         np.ascontiguousarray(system._J, dtype=float).reshape(nr, 3, 3),
         np.ascontiguousarray(system._Jinv, dtype=float).reshape(nr, 3, 3),
         np.ascontiguousarray(system._m_rigid, dtype=float).reshape(nr),
@@ -194,7 +201,7 @@ def rhs(t, Y, G0, parts, dY, total, unmodeled):  # type: ignore[no-untyped-def]
         p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]
         if rig:
             status = apply_term(
-                code, True, t, g[idx], V[idx], m_r[idx], J[idx], params[p0:], fdata[f0:f1], w
+                code, rig != 0, t, g[idx], V[idx], m_r[idx], J[idx], params[p0:], fdata[f0:f1], w
             )
             dof = 6
         else:
@@ -202,7 +209,7 @@ def rhs(t, Y, G0, parts, dY, total, unmodeled):  # type: ignore[no-untyped-def]
                 gp[i, 3] = Y[x0 + idx + i]
                 vp[i] = Y[x0 + ne + idx + i]
             status = apply_term(
-                code, False, t, gp, vp, m_e[idx], no_inertia, params[p0:], fdata[f0:f1], w
+                code, rig != 0, t, gp, vp, m_e[idx], no_inertia, params[p0:], fdata[f0:f1], w
             )
             dof = 3
         if status != 0:

@@ -1,0 +1,276 @@
+"""The compiled step loop (gmuk.integrators._compiled) against the Python loop: every built-in
+part with a compiled form, mixed and ineligible Systems, failures, stops and resumes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import gmuk
+from gmuk import integrate, runs
+from gmuk.errors import DefinitionError, SimulationError
+from gmuk.integrators import _compiled, get_method
+
+MU = 4.9028e12  # m³/s², the Moon
+R0 = 1838e3  # m
+V0 = np.sqrt(MU / R0)
+J = np.array([[150.0, 3.0, -2.0], [3.0, 200.0, 5.0], [-2.0, 5.0, 300.0]])  # kg·m²
+
+
+def _field(degree=12):
+    return gmuk.gravity.load("GRGM660PRIM", degree=degree)
+
+
+def _spinning_moon(degree=12):
+    """The Moon with its field, spinning about N's third axis from a nonzero angle."""
+    return gmuk.CelestialBody.moon(
+        field=_field(degree), rotation=gmuk.UniformRotation(2.66e-6, 0.7)
+    )
+
+
+# Each case: the force models, on a rigid body "sc" and a point mass "p".
+CASES = {
+    "point-mass gravity": lambda: [gmuk.PointMassGravity(MU)],
+    "gravity gradient": lambda: [gmuk.GravityGradient(MU)],
+    "harmonics on the point mass": lambda: [
+        gmuk.SphericalHarmonicGravity(_spinning_moon(), bodies=["p"]),
+        gmuk.PointMassGravity(MU, bodies=["sc"]),
+    ],
+    "uniform gravity, unmodeled spring": lambda: [
+        gmuk.PointMassGravity(MU),
+        gmuk.UniformGravity((0.01, -0.02, 0.03)),
+        gmuk.LinearSpringDamper(1e-6, 1e-4, anchor=(1.0, 2.0, 3.0), modeled=False),
+    ],
+}
+
+
+def _system(forces):
+    sc = gmuk.RigidBody("sc", 500.0, J)
+    p = gmuk.PointMass("p", 3.0)
+    system = gmuk.System([sc, p], [], forces)
+    R = gmuk.lie.so3.exp(np.array([0.3, -0.2, 0.5]))
+    g = np.eye(4)
+    g[:3, :3], g[:3, 3] = R, [R0, 0.0, 0.0]
+    v_N = V0 * np.array([0.0, np.cos(1.4), np.sin(1.4)])
+    state = system.state(
+        g={"sc": g},
+        V={"sc": np.r_[0.01, -0.02, 0.005, R.T @ v_N]},
+        r={"p": [0.0, R0 + 30e3, 1e3]},
+        v={"p": [-V0, 0.0, 20.0]},
+    )
+    return system, state
+
+
+def _program(system, method="DOP853"):
+    prog = _compiled.program(system, get_method(method))
+    assert isinstance(prog, _compiled.Program), prog
+    return prog
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_compiled_right_hand_side_equals_the_python_one_at_random_states(case):
+    system, state = _system(CASES[case]())
+    prog = _program(system)
+    problem = integrate._Problem(system)
+    rng = np.random.default_rng(7)
+    n_dof = system.layout.n_dof
+    for _ in range(40):
+        Y = problem.pack(state)
+        Y[:6] = rng.normal(scale=[0.1, 0.1, 0.1, 50.0, 50.0, 50.0])  # ξ of a step
+        Y[6:12] += rng.normal(scale=[0.01, 0.01, 0.01, 5.0, 5.0, 5.0])
+        Y[12:15] = rng.normal(size=3) * 1e5 + [0.0, R0 + 30e3, 1e3]
+        Y[15:18] += rng.normal(size=3) * 10.0
+        t = float(rng.uniform(0.0, 1e5))
+        G0 = state.g.copy()
+        problem.G0 = G0
+        expected = problem.rhs(t, Y)
+        acc_py = problem.acc
+        dY, total, unmodeled = np.empty(problem.size), np.empty(n_dof), np.empty(n_dof)
+        assert _compiled.rhs(t, Y, G0, prog.parts, dY, total, unmodeled) == 0
+        # per 3-vector, to the rounding of its norm
+        for blk in range(problem.size // 3):
+            sl = slice(3 * blk, 3 * blk + 3)
+            scale = np.linalg.norm(expected[sl])
+            np.testing.assert_allclose(dY[sl], expected[sl], rtol=0, atol=2e-15 * scale + 1e-300)
+        np.testing.assert_allclose(total, acc_py.total, rtol=0, atol=2e-15 * np.abs(total).max())
+        np.testing.assert_array_equal(unmodeled == 0.0, acc_py.unmodeled_force == 0.0)
+        np.testing.assert_allclose(
+            unmodeled, acc_py.unmodeled_force, rtol=0, atol=2e-15 * np.abs(unmodeled).max()
+        )
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"rtol": 1e-11, "atol": 1e-11, "t_eval": [0.0, 700.0, 1500.0, 3000.0]},
+        {"method": "DOPRI5", "rtol": 1e-9, "atol": 1e-9, "t_eval": np.linspace(0, 3000, 7)},
+        {"method": "RK4", "step": 10.0},
+    ],
+    ids=["DOP853", "DOPRI5", "RK4"],
+)
+def test_a_compiled_run_equals_the_python_run(case, options):
+    system, state = _system(CASES[case]())
+    fast = system.simulate(state, (0.0, 3000.0), **options)
+    slow = system.simulate(state, (0.0, 3000.0), compiled=False, **options)
+    assert fast.stats["compiled"] and not slow.stats["compiled"]
+    assert fast.success and slow.success
+    np.testing.assert_array_equal(fast.t, slow.t)
+    assert fast.stats["n_steps"] == slow.stats["n_steps"]
+    assert fast.stats["n_rejected"] == slow.stats["n_rejected"]
+    assert fast.stats["n_rhs"] == slow.stats["n_rhs"]
+    # the same steps; the stage sums round differently: agreement to ~1e-14 of each quantity
+    np.testing.assert_allclose(fast.r_N, slow.r_N, rtol=0, atol=1e-13 * R0)
+    np.testing.assert_allclose(fast.g_NB[..., :3, :3], slow.g_NB[..., :3, :3], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(fast.V_B, slow.V_B, rtol=0, atol=1e-12 * V0)
+    np.testing.assert_allclose(fast.xdot, slow.xdot, rtol=0, atol=1e-12 * V0)
+    scale = np.abs(slow.acceleration).max()
+    np.testing.assert_allclose(fast.acceleration, slow.acceleration, rtol=0, atol=1e-11 * scale)
+    np.testing.assert_allclose(
+        fast.unmodeled_force, slow.unmodeled_force, rtol=0, atol=1e-11 * scale * 500
+    )
+    for name in ("constraint_acceleration", "constraint_force", "control_force", "residual"):
+        np.testing.assert_array_equal(getattr(fast, name), getattr(slow, name))
+    np.testing.assert_array_equal(fast.rank, slow.rank)
+    assert fast.multipliers.shape == slow.multipliers.shape
+
+
+def test_every_accepted_step_is_an_output_when_no_times_are_given():
+    system, state = _system([gmuk.GravityGradient(MU)])
+    fast = system.simulate(state, (0.0, 2000.0), rtol=1e-10, atol=1e-10)
+    slow = system.simulate(state, (0.0, 2000.0), rtol=1e-10, atol=1e-10, compiled=False)
+    assert fast.stats["compiled"]
+    assert len(fast) == fast.stats["n_steps"] + 1 == len(slow)
+    # the embedded error estimate cancels to ~1e-4 of its value, so the step sizes may
+    # differ in their last digits; the states agree to the tolerance's order and far better
+    np.testing.assert_allclose(fast.t, slow.t, rtol=1e-6)
+    np.testing.assert_allclose(fast.g_NB[-1], slow.g_NB[-1], rtol=0, atol=1e-6)
+
+
+def test_many_outputs_inside_one_step_grow_the_buffers():
+    system, state = _system([gmuk.PointMassGravity(MU)])
+    t_eval = np.linspace(0.0, 600.0, 20001)  # more outputs in a step than a chunk has steps
+    fast = system.simulate(state, (0.0, 600.0), t_eval=t_eval, rtol=1e-9, atol=1e-9)
+    slow = system.simulate(state, (0.0, 600.0), t_eval=t_eval, rtol=1e-9, atol=1e-9, compiled=False)
+    assert fast.stats["compiled"]
+    assert t_eval.size / fast.stats["n_steps"] > 2 * integrate._CompiledStepper.chunk
+    np.testing.assert_array_equal(fast.t, t_eval)
+    np.testing.assert_allclose(fast.r_N, slow.r_N, rtol=0, atol=1e-13 * R0)
+
+
+class Drag(gmuk.ForceModel):
+    """A user's force model in Python."""
+
+    def force(self, t, r_N, v_N, body):
+        return -1e-3 * v_N
+
+
+class LoudGravity(gmuk.PointMassGravity):
+    """A built-in model with an overridden method: it has no compiled form."""
+
+    def force(self, t, r_N, v_N, body):
+        return 2.0 * super().force(t, r_N, v_N, body)
+
+
+@pytest.mark.parametrize(
+    ("make", "why"),
+    [
+        (lambda s: gmuk.System(s.bodies, [], [gmuk.PointMassGravity(MU), Drag()]), "'Drag'"),
+        (lambda s: gmuk.System(s.bodies, [], [LoudGravity(MU)]), "'LoudGravity'"),
+        (
+            lambda s: gmuk.System(
+                s.bodies,
+                [gmuk.PlaneBound("p", [0.0, 0.0, 1.0], upper=1e7)],
+                [gmuk.PointMassGravity(MU)],
+            ),
+            "constraints",
+        ),
+    ],
+    ids=["user force model", "overridden built-in", "constraint"],
+)
+def test_a_system_that_does_not_qualify_runs_the_python_loop_and_says_why(make, why):
+    base, _ = _system([])
+    system = make(base)
+    g = np.eye(4)
+    g[0, 3] = R0
+    state = system.state(
+        g={"sc": g},
+        V={"sc": [0, 0, 0, 0, V0, 0]},
+        r={"p": [0.0, R0, 0.0]},
+        v={"p": [-V0, 0.0, 0.0]},
+    )
+    traj = system.simulate(state, (0.0, 100.0), rtol=1e-9, atol=1e-9)
+    assert traj.success and not traj.stats["compiled"]
+    with pytest.raises(DefinitionError, match=f"cannot run compiled: .*{why}"):
+        system.simulate(state, (0.0, 100.0), compiled=True)
+
+
+def test_compiled_takes_a_bool_or_none():
+    system, state = _system([gmuk.PointMassGravity(MU)])
+    with pytest.raises(DefinitionError, match="compiled must be True, False or None"):
+        system.simulate(state, (0.0, 1.0), compiled="yes")
+
+
+def test_a_singularity_inside_the_compiled_loop_fails_as_the_python_loop_does():
+    # a point mass aimed at the centre of a point-mass field: the derivative becomes
+    # non-finite or the step size underflows, in both loops at the same step
+    p = gmuk.PointMass("p", 1.0)
+    system = gmuk.System([p], [], [gmuk.PointMassGravity(MU)])
+    state = system.state(r={"p": [1e6, 0.0, 0.0]}, v={"p": [-5e3, 0.0, 0.0]})
+    results = []
+    for compiled in (None, False):
+        with pytest.raises(SimulationError) as info:
+            system.simulate(state, (0.0, 1000.0), rtol=1e-10, atol=1e-10, compiled=compiled)
+        results.append(info.value)
+    fast, slow = results
+    assert str(fast) == str(slow)
+    assert fast.trajectory.stats["compiled"] and fast.trajectory.status == "failed"
+    # the step sizes agree to the rounding of the error estimate near the singularity
+    assert len(fast.trajectory) == len(slow.trajectory)
+    np.testing.assert_allclose(fast.trajectory.t, slow.trajectory.t, rtol=1e-6)
+
+
+def test_max_steps_is_honoured_by_the_compiled_loop():
+    system, state = _system([gmuk.PointMassGravity(MU)])
+    traj = system.simulate(
+        state, (0.0, 3000.0), rtol=1e-12, atol=1e-12, max_steps=7, on_failure="return"
+    )
+    assert traj.status == "failed" and "max_steps = 7" in traj.message
+    assert traj.stats["n_steps"] == 7 and len(traj) == 8
+
+
+class _StopAfter:
+    """Asks the run to stop once the progress bar has seen ``t_stop``."""
+
+    def __init__(self, t_stop):
+        self.t_stop = t_stop
+
+    def __call__(self, t):  # set on the class: called unbound, as bar.update(t)
+        control = runs.current()
+        if control is not None and t > self.t_stop:
+            control.request_stop()
+
+
+def test_a_compiled_run_stops_between_chunks_and_resumes_to_the_same_result(tmp_path, monkeypatch):
+    system, state = _system([gmuk.GravityGradient(MU)])
+    t_eval = np.linspace(0.0, 3000.0, 31)
+
+    def run():
+        return system.simulate(state, (0.0, 3000.0), t_eval=t_eval, rtol=1e-11, atol=1e-11)
+
+    plain = run()
+    monkeypatch.setattr(integrate._CompiledStepper, "chunk", 8)
+    monkeypatch.setattr(integrate._Progress, "update", _StopAfter(1000.0))
+    with runs.run_control(tmp_path, every_s=3600.0):
+        cut = run()
+    assert cut.status == "interrupted" and cut.stats["compiled"]
+    assert 1000.0 <= cut.t[-1] < 3000.0
+    record = gmuk.load_trajectory(tmp_path / "run-0.npz").stats["checkpoint"]
+    assert record["complete"] is False and 1000.0 < record["t"] < 3000.0
+    monkeypatch.setattr(integrate._Progress, "update", lambda bar, t: None)
+    with runs.run_control(tmp_path, resume=True):
+        resumed = run()
+    assert resumed.success
+    np.testing.assert_array_equal(resumed.t, plain.t)
+    np.testing.assert_allclose(resumed.g_NB, plain.g_NB, rtol=0, atol=1e-6)
+    assert resumed.stats["n_steps"] == plain.stats["n_steps"]
