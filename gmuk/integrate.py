@@ -342,16 +342,17 @@ def simulate(
         the trajectory so far with ``status="interrupted"`` (and a warning).
     compiled : bool, optional
         Run the step loop compiled (:mod:`gmuk.integrators._compiled`): None (default) when
-        the System qualifies — no constraints or controllers, rigid bodies and point masses
-        only, every force model a built-in one with a compiled form (point-mass, Eq. 23 and
-        uniform gravity, the linear spring–damper, spherical harmonics on point masses) —
-        and the method is DOP853 or a plain tableau; True requires it (a
-        :class:`~gmuk.errors.DefinitionError` says why a System does not qualify); False
-        always runs the Python loop. Both loops take the same steps and give the same
-        results to rounding; ``stats["compiled"]`` says which ran. A failure inside the
-        compiled loop (a field evaluated inside the body, a NaN, a step-size underflow) is
-        retried by the Python loop from the last accepted step, which raises the error it
-        always raises, with the trajectory up to there.
+        the System qualifies — rigid bodies and point masses, no controllers, every force
+        model a built-in one with a compiled form (point-mass, Eq. 23 and uniform gravity,
+        the linear spring–damper, spherical harmonics on point masses), and either no
+        constraints or only LVLH configuration tracking and relative constraints on rigid
+        bodies (the "fused" solve) — and the method is DOP853 or a plain tableau; True
+        requires it (a :class:`~gmuk.errors.DefinitionError` says why a System does not
+        qualify); False always runs the Python loop. Both loops give the same results to
+        rounding (docs/architecture.rst); ``stats["compiled"]`` says which ran. A failure
+        inside the compiled loop (a field evaluated inside the body, a NaN, a step-size
+        underflow, a solve it cannot certify) is retried by the Python loop from the last
+        accepted step, which raises the error it always raises, with the trajectory so far.
 
     Returns
     -------
@@ -722,9 +723,9 @@ class _Stepper:
             self._after_step()
 
 
-#: The compiled loop's output buffers: times, states Y, base poses, total accelerations and
-#: unmodeled generalized forces, one row per output.
-_Buffers = tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
+#: The compiled loop's output buffers: times, states Y, base poses and the right-hand side's
+#: other outputs (gmuk.integrators._compiled.rhs), one row per output.
+_Buffers = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
 
 
 class _CompiledStepper(_Stepper):
@@ -753,16 +754,20 @@ class _CompiledStepper(_Stepper):
 
     def _block(self, n_out: int, bufs: _Buffers, acc0: Accelerations) -> dict[str, Any]:
         """The first ``n_out`` buffered outputs as Trajectory columns."""
-        bt, bY, bG, bacc, bunm = (b[:n_out] for b in bufs)
+        bt, bY, bG, baux = (b[:n_out] for b in bufs)
         p = self.p
         lay = p.layout
-        nr = lay.n_rigid
+        nr, nd, s = lay.n_rigid, lay.n_dof, self.program.s
         if nr:
             xi = bY[:, p.s_xi].reshape(-1, 6)
             g = _kernels.compose_exp(np.ascontiguousarray(bG).reshape(-1, 4, 4), xi)
         else:
-            g = np.zeros((n_out * nr, 4, 4))
-        zeros = np.zeros((n_out, lay.n_dof))
+            g = np.zeros((0, 4, 4))
+        if s:  # the fused solve certified every row: its rank is s
+            residual, rank = baux[:, 4 * nd + s].copy(), np.full(n_out, s, dtype=np.int64)
+        else:  # the unconstrained solve's constants
+            residual = np.full(n_out, float(acc0.residual))
+            rank = np.full(n_out, -1 if acc0.rank is None else acc0.rank, dtype=np.int64)
         return {
             "t": bt.copy(),
             "g_NB": g.reshape(n_out, nr, 4, 4),
@@ -770,14 +775,14 @@ class _CompiledStepper(_Stepper):
             "x": bY[:, p.s_x].copy(),
             "xdot": bY[:, p.s_xd].copy(),
             "z": np.zeros((n_out, 0)),
-            "acceleration": bacc.copy(),
-            "constraint_acceleration": zeros,
-            "constraint_force": zeros,
-            "control_force": zeros,
-            "unmodeled_force": bunm.copy(),
-            "multipliers": np.zeros((n_out, 0)),
-            "residual": np.full(n_out, float(acc0.residual)),
-            "rank": np.full(n_out, -1 if acc0.rank is None else acc0.rank, dtype=np.int64),
+            "acceleration": baux[:, :nd].copy(),
+            "constraint_acceleration": baux[:, 2 * nd : 3 * nd].copy(),
+            "constraint_force": baux[:, 3 * nd : 4 * nd].copy(),
+            "control_force": np.zeros((n_out, nd)),
+            "unmodeled_force": baux[:, nd : 2 * nd].copy(),
+            "multipliers": baux[:, 4 * nd : 4 * nd + s].copy(),
+            "residual": residual,
+            "rank": rank,
         }
 
     def run(
@@ -817,10 +822,11 @@ class _CompiledStepper(_Stepper):
         # the accelerations at the start, in Python: the constant residual and rank of an
         # unconstrained solve, and the first output row exactly as the Python loop makes it
         acc0 = self.p.system._accelerations(p.state(t, Y, G0))
-        f0, acc, unm = np.empty(n), np.empty(n_dof), np.empty(n_dof)
+        n_aux = 4 * n_dof + prog.s + 1
+        f0, aux = np.empty(n), np.empty(n_aux)
         ints[_compiled.I_RHS] += 1
         fs = np.array([t, 0.0, t_end, self.rtol, self.atol, self.max_step, 0.0])
-        status = _compiled.rhs(t, Y, G0, prog.parts, f0, acc, unm)
+        status = _compiled.rhs(t, Y, G0, prog.parts, f0, aux)
         if resume is None and status == 0:
             if outs is None or outs[0] == t:
                 rec.add(state0, acc0)
@@ -839,7 +845,7 @@ class _CompiledStepper(_Stepper):
             return
         out_arr = np.zeros(0) if outs is None else outs
         cap = self.chunk + 1
-        bufs = self._buffers(cap, n, p.layout.n_rigid, n_dof)
+        bufs = self._buffers(cap, n, p.layout.n_rigid, n_aux)
         ints[_compiled.I_MAX_STEPS] = max_steps
         ints[_compiled.I_CHUNK] = self.chunk
         fs[_compiled.F_H] = h
@@ -848,7 +854,7 @@ class _CompiledStepper(_Stepper):
             fs[_compiled.F_T] = t
             ints[_compiled.I_WRITTEN] = 0
             status = _compiled.advance(
-                prog.parts, prog.method, fs, ints, Y, G0, f0, acc, unm,
+                prog.parts, prog.method, fs, ints, Y, G0, f0, aux,
                 out_arr, outs is not None, *bufs,
             )  # fmt: skip
             n_out = int(ints[_compiled.I_WRITTEN])
@@ -869,18 +875,12 @@ class _CompiledStepper(_Stepper):
                 return
             if status == _compiled.FULL and n_out == 0:  # one step has more outputs than room
                 cap = 2 * int(ints[_compiled.I_NEED]) + cap
-                bufs = self._buffers(cap, n, p.layout.n_rigid, n_dof)
+                bufs = self._buffers(cap, n, p.layout.n_rigid, n_aux)
             self._after_step()
 
     @staticmethod
-    def _buffers(cap: int, n: int, nr: int, n_dof: int) -> _Buffers:
-        return (
-            np.empty(cap),
-            np.empty((cap, n)),
-            np.empty((cap, nr, 4, 4)),
-            np.empty((cap, n_dof)),
-            np.empty((cap, n_dof)),
-        )
+    def _buffers(cap: int, n: int, nr: int, n_aux: int) -> _Buffers:
+        return np.empty(cap), np.empty((cap, n)), np.empty((cap, nr, 4, 4)), np.empty((cap, n_aux))
 
     def _hand_over(
         self,

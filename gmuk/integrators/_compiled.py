@@ -28,14 +28,21 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk._numba import njit
-from gmuk._uk_kernels import rigid_free_accel
+from gmuk._uk_kernels import relative_rows, rigid_free_accel, tracking_b, uk_rigid
 from gmuk.bodies import BodyKind
 from gmuk.forces._kernels import apply_term
 from gmuk.gravity import _kernels as _field_kernels
 from gmuk.integrators import _dop853_tableau as _tab
 from gmuk.integrators._base import RungeKuttaMethod
 from gmuk.integrators.dop853 import DOP853
-from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
+from gmuk.lie._kernels import (
+    _compose_exp_into,
+    _dexp_inv_apply_into,
+    _se3_Ad_into,
+    _se3_inverse_into,
+    _se3_log_into,
+)
+from gmuk.orbits._kernels import lvlh_state
 
 if TYPE_CHECKING:
     from gmuk.system import System
@@ -70,6 +77,8 @@ class Program:
     parts: tuple[Any, ...]
     method: tuple[Any, ...]
     n: int
+    #: rows of the stacked constraints
+    s: int
 
 
 def _generic(method: RungeKuttaMethod) -> bool:
@@ -89,8 +98,9 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
         return "the System subclass overrides accelerations"
     if type(system.solver).__module__ != "gmuk.solvers":
         return f"the solve strategy {type(system.solver).__name__} is not a built-in one"
-    if system.constraints:
-        return "the System has constraints"
+    cons, cparams, uk_params = _constraint_program(system)
+    if isinstance(cons, str):
+        return cons
     if system.controllers:
         return "the System has controllers"
     lay = system.layout
@@ -139,7 +149,13 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
         np.ascontiguousarray(system._m_euclid, dtype=float).reshape(ne),
         np.asarray(lay.rigid_offsets, dtype=np.int64),
         np.asarray(lay.euclid_offsets, dtype=np.int64),
-        np.array([nr, ne, lay.n_dof, int(system._plant_only_loads)], dtype=np.int64),
+        np.array(
+            [nr, ne, lay.n_dof, int(system._plant_only_loads), int(cons[:, 4].sum())],
+            dtype=np.int64,
+        ),
+        cons,
+        cparams,
+        uk_params,
     )
     s = method.n_stages
     E = np.zeros(method._n_rows) if method.E is None else np.asarray(method.E, dtype=float)
@@ -166,17 +182,88 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
         np.ascontiguousarray(_tab.D),
         ints,
     )
-    return Program(parts, meth, 12 * nr + 2 * ne)
+    return Program(parts, meth, 12 * nr + 2 * ne, int(cons[:, 4].sum()))
+
+
+# Constraint kinds of the compiled right-hand side.
+TRACKING_LVLH = 0  #: ConfigurationTracking of an LVLHReference (Eq. 67), Baumgarte optional
+RELATIVE = 1  #: RelativeConstraint with a zero desired relative motion (Eq. 73)
+
+
+def _gains(baumgarte: Any, n: int) -> list[float] | None:
+    """[flag, α (n), β (n)] with the gains broadcast to n rows (zeros without Baumgarte), or
+    None when they do not broadcast."""
+    if baumgarte is None:
+        return [0.0] * (1 + 2 * n)
+    try:
+        alpha = np.broadcast_to(np.asarray(baumgarte.alpha, dtype=float), (n,))
+        beta = np.broadcast_to(np.asarray(baumgarte.beta, dtype=float), (n,))
+    except ValueError:
+        return None
+    return [1.0, *alpha.tolist(), *beta.tolist()]
+
+
+def _constraint_program(system: System) -> tuple[Any, Any, Any]:
+    """(cons (n_c, 6) int64 — kind, body, other body, first row, rows, parameter start —,
+    parameters, the fused solve's packed constants), or (why not, None, None)."""
+    from gmuk.constraints.relative import RelativeConstraint
+    from gmuk.constraints.tracking import ConfigurationTracking
+    from gmuk.orbits.lvlh import LVLHReference
+    from gmuk.solvers import FusedRigidSolver
+
+    empty = (np.zeros((0, 6), dtype=np.int64), np.zeros(1), np.zeros(1))
+    if not system.constraints:
+        return empty
+    if type(system.solver) is not FusedRigidSolver:
+        return "the System's constraints are solved by another strategy than 'fused'", None, None
+    rows: list[list[int]] = []
+    params: list[float] = []
+    row = 0
+    for c in system.constraints:
+        idx = [system.layout.slot(system._resolve(b)).index for b in c.bodies]
+        start = len(params)
+        if type(c) is ConfigurationTracking and type(c.reference) is LVLHReference:
+            o = c.reference.orbit
+            bg = c.baumgarte
+            params += [o.mean_motion, o.e, o.mu, o.p, *np.ravel(c.reference._R_NP)]
+            gains = _gains(bg, 6)
+            if gains is None:
+                return f"constraint {c.name!r}: Baumgarte gains of another shape", None, None
+            params += gains
+            rows.append([TRACKING_LVLH, idx[0], idx[0], row, 6, start])
+            row += 6
+        elif (
+            type(c) is RelativeConstraint
+            and c.acceleration is None
+            and (c.baumgarte is None or c.velocity is None)
+        ):
+            S = np.asarray(c.S, dtype=float)
+            gains = _gains(c.baumgarte, S.shape[0])
+            if gains is None:
+                return f"constraint {c.name!r}: Baumgarte gains of another shape", None, None
+            params += [*gains[1 : 1 + S.shape[0]], *S.ravel()]
+            rows.append([RELATIVE, idx[0], idx[1], row, S.shape[0], start])
+            row += S.shape[0]
+        else:
+            return f"constraint {c.name!r} has no compiled form", None, None
+    solver = system.solver
+    return np.array(rows, dtype=np.int64), np.array([*params, 0.0]), solver._params
 
 
 # ------------------------------------------------------------------------ right-hand side
+UK_FAILED = -5  #: the fused solve did not certify its answer (the Python loop decides)
+
+
 @njit(cache=True)
-def rhs(t, Y, G0, parts, dY, total, unmodeled):  # type: ignore[no-untyped-def]
-    """dY/dt at (t, Y) about the base poses G0 into ``dY``; the total acceleration (n_dof,)
-    into ``total`` and the unmodeled generalized forces into ``unmodeled``. Returns 0, the
-    negated status of a failed force kernel (< 0 − 100), or NONFINITE."""
-    terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims = parts
-    nr, ne, ndof, plant = dims[0], dims[1], dims[2], dims[3]
+def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
+    """dY/dt at (t, Y) about the base poses G0 into ``dY``, and into ``aux`` (4 n_dof + s + 1)
+    the total acceleration, the unmodeled generalized forces, the constraint acceleration,
+    the constraint wrenches M ν̇_c, the multipliers λ (s) and the solve's residual. Returns 0,
+    NONFINITE, UK_FAILED, or −100 − the status of a failed force kernel."""
+    terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims, cons, cparams, P = parts
+    nr, ne, ndof, plant, s = dims[0], dims[1], dims[2], dims[3], dims[4]
+    total = aux[:ndof]
+    unmodeled = aux[ndof : 2 * ndof]
     xi = np.empty((nr, 6))
     V = np.empty((nr, 6))
     any_xi = False
@@ -190,7 +277,8 @@ def rhs(t, Y, G0, parts, dY, total, unmodeled):  # type: ignore[no-untyped-def]
     if nr:
         _compose_exp_into(G0, xi, g)
     modeled = np.zeros(ndof)
-    unmodeled[:] = 0.0
+    for i in range(ndof):
+        unmodeled[i] = 0.0
     w = np.empty(6)
     gp = np.zeros((4, 4))
     vp = np.zeros(6)
@@ -220,30 +308,49 @@ def rhs(t, Y, G0, parts, dY, total, unmodeled):  # type: ignore[no-untyped-def]
         else:
             for i in range(dof):
                 unmodeled[off + i] += w[i]
-    # ν̇_a = M⁻¹(ad*_V 𝕀V + Q): Eq. 10b for rigid bodies, Q/m for point masses
-    if nr:
-        Q = np.empty((nr, 6))
-        for k in range(nr):
-            for i in range(6):
-                Q[k, i] = modeled[r_off[k] + i]
-        a_r = rigid_free_accel(V, J, Jinv, m_r, Q)
-        for k in range(nr):
-            for i in range(6):
-                total[r_off[k] + i] = a_r[k, i]
-    for i in range(ne):
-        total[e_off[i]] = modeled[e_off[i]] / m_e[i]
-    if plant:  # unmodeled loads act on the plant: + M⁻¹ Q_u
-        for k in range(nr):
-            o = r_off[k]
-            for i in range(3):
-                total[o + i] += (
-                    Jinv[k, i, 0] * unmodeled[o]
-                    + Jinv[k, i, 1] * unmodeled[o + 1]
-                    + Jinv[k, i, 2] * unmodeled[o + 2]
-                )
-                total[o + 3 + i] += unmodeled[o + 3 + i] / m_r[k]
+    if s:
+        # rigid bodies only (the fused strategy): the rows, then one compiled UK solve
+        A = np.zeros((s, ndof))
+        b = np.empty(s)
+        _constraint_rows(t, g, V, cons, cparams, A, b)
+        out = np.empty(4 * ndof + s + 3)
+        uk_rigid(V, modeled, A, b, P, out)
+        if out[4 * ndof + s + 2] != 0.0:
+            return UK_FAILED
+        for i in range(ndof):
+            total[i] = out[2 * ndof + i]
+            aux[2 * ndof + i] = out[ndof + i]
+            aux[3 * ndof + i] = out[3 * ndof + i]
+        for i in range(s):
+            aux[4 * ndof + i] = out[4 * ndof + i]
+        aux[4 * ndof + s] = out[4 * ndof + s]
+    else:
+        for i in range(2 * ndof, 4 * ndof + 1):
+            aux[i] = 0.0
+        # ν̇_a = M⁻¹(ad*_V 𝕀V + Q): Eq. 10b for rigid bodies, Q/m for point masses
+        if nr:
+            Q = np.empty((nr, 6))
+            for k in range(nr):
+                for i in range(6):
+                    Q[k, i] = modeled[r_off[k] + i]
+            a_r = rigid_free_accel(V, J, Jinv, m_r, Q)
+            for k in range(nr):
+                for i in range(6):
+                    total[r_off[k] + i] = a_r[k, i]
         for i in range(ne):
-            total[e_off[i]] += unmodeled[e_off[i]] / m_e[i]
+            total[e_off[i]] = modeled[e_off[i]] / m_e[i]
+        if plant:  # unmodeled loads act on the plant: + M⁻¹ Q_u
+            for k in range(nr):
+                o = r_off[k]
+                for i in range(3):
+                    total[o + i] += (
+                        Jinv[k, i, 0] * unmodeled[o]
+                        + Jinv[k, i, 1] * unmodeled[o + 1]
+                        + Jinv[k, i, 2] * unmodeled[o + 2]
+                    )
+                    total[o + 3 + i] += unmodeled[o + 3 + i] / m_r[k]
+            for i in range(ne):
+                total[e_off[i]] += unmodeled[e_off[i]] / m_e[i]
     # dY = [dexp⁻¹(ξ) V, V̇, ẋ, ẍ]
     if nr:
         if any_xi:
@@ -265,6 +372,95 @@ def rhs(t, Y, G0, parts, dY, total, unmodeled):  # type: ignore[no-untyped-def]
         if not math.isfinite(dY[i]):
             return NONFINITE
     return 0
+
+
+@njit(cache=True)
+def _constraint_rows(t, g, V, cons, cparams, A, b):  # type: ignore[no-untyped-def]
+    """The stacked rows (A, b) of the compiled constraints, as their ``rows`` give them."""
+    gd = np.empty((4, 4))
+    Vd = np.empty(6)
+    Vd_dot = np.empty(6)
+    bk = np.empty(6)
+    R_NP = np.empty((3, 3))
+    for c in range(cons.shape[0]):
+        kind, i, j, r0, nrow, p0 = (
+            cons[c, 0],
+            cons[c, 1],
+            cons[c, 2],
+            cons[c, 3],
+            cons[c, 4],
+            cons[c, 5],
+        )
+        if kind == TRACKING_LVLH:
+            for a in range(3):
+                for e in range(3):
+                    R_NP[a, e] = cparams[p0 + 4 + 3 * a + e]
+            lvlh_state(
+                t,
+                cparams[p0],
+                cparams[p0 + 1],
+                cparams[p0 + 2],
+                cparams[p0 + 3],
+                R_NP,
+                gd,
+                Vd,
+                Vd_dot,
+            )
+            tracking_b(g[i], V[i], gd, Vd, Vd_dot, bk)
+            if cparams[p0 + 13] != 0.0:
+                _baumgarte_tracking(g[i], V[i], gd, Vd, cparams[p0 + 14 :], cparams[p0 + 20 :], bk)
+            for r in range(6):
+                A[r0 + r, 6 * i + r] = 1.0
+                b[r0 + r] = bk[r]
+        else:  # RELATIVE: columns [V_L, V_B]
+            S = np.empty((nrow, 6))
+            for a in range(nrow):
+                for e in range(6):
+                    S[a, e] = cparams[p0 + nrow + 6 * a + e]
+            Ak = np.empty((nrow, 12))
+            bkr = np.empty(nrow)
+            V_BL = np.empty(6)
+            relative_rows(g[i], V[i], g[j], V[j], S, np.zeros(6), Ak, bkr, V_BL)
+            for a in range(nrow):
+                alpha = cparams[p0 + a]
+                if alpha != 0.0:
+                    q = 0.0
+                    for e in range(6):
+                        q += S[a, e] * V_BL[e]
+                    bkr[a] = bkr[a] - alpha * q
+                b[r0 + a] = bkr[a]
+                for e in range(6):
+                    A[r0 + a, 6 * i + e] = Ak[a, e]
+                    A[r0 + a, 6 * j + e] = Ak[a, 6 + e]
+
+
+@njit(cache=True)
+def _baumgarte_tracking(g, V, gd, Vd, alpha, beta, b):  # type: ignore[no-untyped-def]
+    """b ← b − α e_V − β e_g (gains per row) with e_g = log(g_d⁻¹ g) and
+    e_V = V − Ad_{(g_d⁻¹ g)⁻¹} V_d (gmuk.constraints.tracking.tracking_errors)."""
+    gd_inv = np.zeros((1, 4, 4))
+    gd1 = np.empty((1, 4, 4))
+    gd1[0] = gd
+    _se3_inverse_into(gd1, gd_inv)
+    g_err = np.zeros((1, 4, 4))
+    for a in range(4):
+        for e in range(4):
+            q = 0.0
+            for m in range(4):
+                q += gd_inv[0, a, m] * g[m, e]
+            g_err[0, a, e] = q
+    e_g = np.empty((1, 6))
+    _se3_log_into(g_err, e_g)
+    g_err_inv = np.zeros((1, 4, 4))
+    _se3_inverse_into(g_err, g_err_inv)
+    Ad = np.zeros((1, 6, 6))
+    _se3_Ad_into(g_err_inv, Ad)
+    for a in range(6):
+        q = 0.0
+        for e in range(6):
+            q += Ad[0, a, e] * Vd[e]
+        e_V = V[a] - q
+        b[a] = b[a] - alpha[a] * e_V - beta[a] * e_g[0, a]
 
 
 @njit(cache=True)
@@ -314,10 +510,9 @@ def initial_step(t, Y, G0, f0, t_end, first_step, max_step, order, parts, fs, in
     h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
     h0 = min(h0, t_end - t)
     f1 = np.empty(n)
-    total = np.empty(ndof)
-    unm = np.empty(ndof)
+    aux = np.empty(4 * ndof + parts[9][4] + 1)
     ints[I_RHS] += 1
-    status = rhs(t + h0, Y + h0 * f0, G0, parts, f1, total, unm)
+    status = rhs(t + h0, Y + h0 * f0, G0, parts, f1, aux)
     if status != 0:
         ints[I_FIELD] = status
         fs[F_BAD_T] = t + h0
@@ -353,12 +548,12 @@ def _interpolate(F, Y0, s, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, bG, bacc, bunm):  # type: ignore[no-untyped-def]
-    """Run steps from (fs[F_T], Y, G0) with f0 = f(t, Y) and the accelerations ``acc`` /
-    ``unm`` of that evaluation, until the end time, ``ints[I_CHUNK]`` steps, full output
-    buffers or a failure; returns the status (module constants). Y, G0, f0, acc, unm, fs and
+def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux):  # type: ignore[no-untyped-def]
+    """Run steps from (fs[F_T], Y, G0) with f0 = f(t, Y) and the outputs ``aux`` of that
+    evaluation (see :func:`rhs`), until the end time, ``ints[I_CHUNK]`` steps, full output
+    buffers or a failure; returns the status (module constants). Y, G0, f0, aux, fs and
     ints are updated in place to the last accepted step; outputs are appended to the buffers
-    (bt, bY, bG, bacc, bunm) from ints[I_WRITTEN]."""
+    (times bt, states bY, base poses bG, rhs outputs baux) from ints[I_WRITTEN]."""
     A, b, c, E, E3, Ax, Cx, D, mi = meth
     s, n_rows, fsal, adaptive, order, dop853, dense = (
         mi[0],
@@ -370,7 +565,7 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
         mi[6],
     )
     dims = parts[9]
-    nr, ne, ndof = dims[0], dims[1], dims[2]
+    nr, ne = dims[0], dims[1]
     n = Y.shape[0]
     t, h, t_end = fs[F_T], fs[F_H], fs[F_END]
     rtol, atol, max_step = fs[F_RTOL], fs[F_ATOL], fs[F_MAX_STEP]
@@ -387,10 +582,9 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
     Y1 = np.empty(n)
     f1 = np.empty(n)
     sc = np.empty(n)
-    acc1 = np.empty(ndof)
-    unm1 = np.empty(ndof)
-    tmp_acc = np.empty(ndof)
-    tmp_unm = np.empty(ndof)
+    n_aux = aux.shape[0]
+    aux1 = np.empty(n_aux)
+    tmp_aux = np.empty(n_aux)
     G1 = np.empty((nr, 4, 4))
     R = np.empty((3, 3))
     RtR = np.empty((3, 3))
@@ -438,12 +632,12 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
                     q += A[i, m] * K[m, j]
                 Yt[j] = Y[j] + h_try * q
             ints[I_RHS] += 1
-            bad = rhs(t + c[i] * h_try, Yt, G0, parts, K[i], tmp_acc, tmp_unm)
+            bad = rhs(t + c[i] * h_try, Yt, G0, parts, K[i], tmp_aux)
             if bad != 0:
                 fs[F_BAD_T] = t + c[i] * h_try
                 break
         if bad != 0:
-            status = bad if bad == NONFINITE else FIELD
+            status = bad if bad > -100 else FIELD
             ints[I_FIELD] = bad
             break
         for j in range(n):
@@ -452,10 +646,10 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
                 q += b[i] * K[i, j]
             Y1[j] = Y[j] + h_try * q
         ints[I_RHS] += 1
-        bad = rhs(t + h_try, Y1, G0, parts, f1, acc1, unm1)
+        bad = rhs(t + h_try, Y1, G0, parts, f1, aux1)
         if bad != 0:
             fs[F_BAD_T] = t + h_try
-            status = bad if bad == NONFINITE else FIELD
+            status = bad if bad > -100 else FIELD
             ints[I_FIELD] = bad
             break
         if fsal:
@@ -506,12 +700,12 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
                         q += Ax[i, m] * Kx[m, j]
                     Yt[j] = Y[j] + h_try * q
                 ints[I_RHS] += 1
-                bad = rhs(t + Cx[i] * h_try, Yt, G0, parts, Kx[i], tmp_acc, tmp_unm)
+                bad = rhs(t + Cx[i] * h_try, Yt, G0, parts, Kx[i], tmp_aux)
                 if bad != 0:
                     fs[F_BAD_T] = t + Cx[i] * h_try
                     break
             if bad != 0:
-                status = bad if bad == NONFINITE else FIELD
+                status = bad if bad > -100 else FIELD
                 ints[I_FIELD] = bad
                 break
             last = _tab.N_STAGES
@@ -543,10 +737,10 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
                 for j in range(n):
                     u[j] += Y[j]
                 ints[I_RHS] += 1
-                bad = rhs(t + s_star * h_try, u, G0, parts, ddy, tmp_acc, tmp_unm)
+                bad = rhs(t + s_star * h_try, u, G0, parts, ddy, tmp_aux)
                 if bad != 0:
                     fs[F_BAD_T] = t + s_star * h_try
-                    status = bad if bad == NONFINITE else FIELD
+                    status = bad if bad > -100 else FIELD
                     ints[I_FIELD] = bad
                     break
                 acc2 = 0.0
@@ -563,7 +757,7 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
                 tt = outs[out_i]
                 w = ints[I_WRITTEN]
                 _interpolate(F, Y, (tt - t) / h_try, bY[w])
-                bad = rhs(tt, bY[w], G0, parts, ddy, bacc[w], bunm[w])
+                bad = rhs(tt, bY[w], G0, parts, ddy, baux[w])
                 if bad != 0:
                     fs[F_BAD_T] = tt
                     break
@@ -573,7 +767,7 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
                 ints[I_WRITTEN] = w + 1
                 out_i += 1
             if bad != 0:
-                status = bad if bad == NONFINITE else FIELD
+                status = bad if bad > -100 else FIELD
                 ints[I_FIELD] = bad
                 break
         # the new base G₁ = G₀ exp(ξ₁), re-orthonormalised: R ← R(3I − RᵀR)/2
@@ -607,14 +801,13 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
             f0[i] = Y[6 * nr + i]
         for k in range(nr):
             for i in range(6):
-                f0[6 * nr + 6 * k + i] = acc1[parts[7][k] + i]
+                f0[6 * nr + 6 * k + i] = aux1[parts[7][k] + i]
         x0 = 12 * nr
         for i in range(ne):
             f0[x0 + i] = Y[x0 + ne + i]
-            f0[x0 + ne + i] = acc1[parts[8][i]]
-        for i in range(ndof):
-            acc[i] = acc1[i]
-            unm[i] = unm1[i]
+            f0[x0 + ne + i] = aux1[parts[8][i]]
+        for i in range(n_aux):
+            aux[i] = aux1[i]
         if (not has_outs) or (out_i < n_outs and outs[out_i] == t_new):
             w = ints[I_WRITTEN]
             bt[w] = t_new
@@ -622,9 +815,8 @@ def advance(parts, meth, fs, ints, Y, G0, f0, acc, unm, outs, has_outs, bt, bY, 
                 bY[w, j] = Y[j]
             for k in range(nr):
                 bG[w, k] = G0[k]
-            for i in range(ndof):
-                bacc[w, i] = acc1[i]
-                bunm[w, i] = unm1[i]
+            for i in range(n_aux):
+                baux[w, i] = aux1[i]
             ints[I_WRITTEN] = w + 1
             if has_outs:
                 out_i += 1
