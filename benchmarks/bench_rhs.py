@@ -1,7 +1,10 @@
 """Where a right-hand side goes: one FCEI orbit end to end and the per-call cost of its
 parts, and a point mass in the GRAIL field (issue #14's per-RHS overhead).
 
-Rows: ``gmuk.scenarios.fcei.run()`` (median of 7 runs after one warm-up); for the FCEI
+Rows: ``gmuk.scenarios.fcei.run()`` (median of 7 runs after one warm-up); its ``simulate``
+call alone with the compiled and with the Python step loop, and the wall time per
+right-hand side evaluation of each (everything the loop does, divided by its evaluations);
+for the FCEI
 System (built as ``gmuk.scenarios._lvlh.fully_constrained`` builds it) one right-hand side
 ``_Problem.rhs`` at a new time per call, ``LVLHReference.evaluate`` at a new time and
 ``GravityGradient.wrench``; for a 300 kg point mass in GRGM660PRIM to degree 50 one
@@ -38,6 +41,27 @@ def per_call_us(fn, number: int = 5000, repeat: int = 7) -> float:
     return statistics.median(timeit.repeat(fn, number=number, repeat=repeat)) / number * 1e6
 
 
+def fcei_orbit_run(compiled: bool | None) -> tuple[float, float]:
+    """Median wall time (s) of one FCEI orbit as the scenario runs it, and µs per RHS."""
+    orbit = fcei_orbit(common.MU)
+    craft, ref = common.spacecraft(), LVLHReference(orbit)
+    system = gmuk.System(
+        [craft], [gmuk.ConfigurationTracking(craft, ref)], [gmuk.GravityGradient(orbit.mu)]
+    )
+    r0 = ref.evaluate(0.0)
+    state = system.state(g={craft.name: r0.g}, V={craft.name: r0.V})
+    t = common.time_grid(orbit, 1.0)
+    options = {"t_eval": t, "rtol": common.RTOL, "atol": common.ATOL, "compiled": compiled}
+    traj = system.simulate(state, (0.0, t[-1]), **options)
+    walls = []
+    for _ in range(7):
+        t0 = time.perf_counter()
+        system.simulate(state, (0.0, t[-1]), **options)
+        walls.append(time.perf_counter() - t0)
+    wall = statistics.median(walls)
+    return wall, wall / traj.stats["n_rhs"] * 1e6
+
+
 def main() -> None:
     fcei.run()
     runs = []
@@ -46,6 +70,12 @@ def main() -> None:
         fcei.run()
         runs.append(time.perf_counter() - t0)
     rows = [("gmuk.scenarios.fcei.run(), one orbit (s)", statistics.median(runs))]
+    for compiled, name in ((None, "compiled loop"), (False, "Python loop")):
+        wall, per_rhs = fcei_orbit_run(compiled)
+        rows += [
+            (f"FCEI orbit, simulate only, {name} (s)", wall),
+            (f"FCEI orbit, {name}: µs per right-hand side, whole run", per_rhs),
+        ]
 
     orbit = fcei_orbit(common.MU)
     craft, ref = common.spacecraft(), LVLHReference(orbit)
