@@ -469,7 +469,8 @@ def plot_orbit_3d(
 
     view = traj.body(body)
     r_N, R_NB = view.position, view.R
-    size = max(float(np.ptp(r_N, axis=0).max()), 2.0 * (central_radius or 0.0), 1e-9)
+    size = max(float(np.ptp(r_N, axis=0).max()), 2.0 * (central_radius or 0.0))
+    size = size if size > 1e-6 else 1.0  # a body at rest: a 1 m scene
     scale, unit = (1e-3, "km") if size > KM_ABOVE_M else (1.0, "m")
     length = (triad_length if triad_length is not None else 0.12 * size) * scale
     plt = _pyplot()

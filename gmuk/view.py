@@ -116,7 +116,8 @@ def view_html(
         Heading of the view.
     triad_length : float, optional
         Length (m) of each drawn body axis; default 12 % of the scene's size (the bodies of
-        an orbit would be invisible at scale).
+        an orbit would be invisible at scale), the scene being 1 m across when the bodies do
+        not move.
     max_frames : int
         Most animation frames (≥ 2); see the module's notes on decimation.
     max_path_points : int
@@ -150,7 +151,8 @@ def view_html(
 
     allpos = np.concatenate([r[path_idx] for _, r, _ in bodies])
     size = float(np.ptp(allpos, axis=0).max()) if len(allpos) > 1 else 0.0
-    size = max(size, 2.0 * central_radius if central_radius else 0.0, 1e-9)
+    size = max(size, 2.0 * central_radius if central_radius else 0.0)
+    size = size if size > 1e-6 else 1.0  # bodies at rest: a 1 m scene
     scale, unit = (1e-3, "km") if size > KM_ABOVE_M else (1.0, "m")
     length = triad_length if triad_length is not None else 0.12 * size
 
@@ -239,7 +241,9 @@ def view_html(
         margin={"l": 0, "r": 0, "t": 40, "b": 0},
         legend={"x": 0.01, "y": 0.95},
         scene={
+            "domain": {"x": [0.0, 1.0], "y": [0.12, 1.0]},  # the slider below it
             "aspectmode": "data",
+            "camera": {"eye": {"x": 0.6, "y": -1.3, "z": 1.2}},
             "xaxis": {**axis, "title": {"text": f"x_N ({unit})"}},
             "yaxis": {**axis, "title": {"text": f"y_N ({unit})"}},
             "zaxis": {**axis, "title": {"text": f"z_N ({unit})"}},
@@ -278,10 +282,11 @@ def view_html(
                 "active": 0,
                 "x": 0.15,
                 "y": 0.02,
-                "font": {"size": 9},
+                "font": {"color": "rgba(0,0,0,0)"},  # one tick per frame: no labels
+                "ticklen": 2,
                 "len": 0.83,
                 "yanchor": "bottom",
-                "currentvalue": {"prefix": "t = ", "suffix": " s"},
+                "currentvalue": {"prefix": "t = ", "suffix": " s", "font": {"color": "#333"}},
                 "steps": [
                     {"label": label, "method": "animate", "args": [[label], step_args]}
                     for label in names
@@ -293,7 +298,8 @@ def view_html(
         include_plotlyjs=True,
         include_mathjax=False,
         full_html=True,
-        default_height="96vh",
+        auto_play=False,  # start at t0; the Play button animates
+        default_height="92vh",
         config={"displaylogo": False, "responsive": True},
     )
     return html

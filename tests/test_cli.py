@@ -212,7 +212,8 @@ def test_gmuk_run_alone_runs_fcei_with_its_defaults(tmp_path, monkeypatch, capsy
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenario"] == "fcei" and summary["orbits"] == 1.0
     assert summary["options"] == {"orbits": 1.0}
-    assert len(list(out.glob("*.png"))) == 6
+    assert len(list(out.glob("*.png"))) == 7  # the six thesis groups and orbit_3d
+    assert (out / "view.html").is_file()
     assert "fcei (orbits=1.0)" in capsys.readouterr().out
 
 

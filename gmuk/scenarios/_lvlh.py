@@ -210,11 +210,13 @@ def figures_for(
     comparisons: Sequence[tuple[str, str, bool]] = (),
 ) -> list[Path]:
     """The thesis figure groups of the primary run, and for each (a, b, difference) in
-    ``comparisons`` the difference a − b (or both overlaid) of the spacecraft."""
+    ``comparisons`` the difference a − b (or both overlaid) of the spacecraft, and the 3-D
+    orbit with attitude triads (``orbit_3d``)."""
     trajs = result.trajectories
     paths = plotting.plot_body(
         trajs[result.primary], "spacecraft", out, formats, label=result.primary.upper()
     )
+    paths += orbit_figure(result, "spacecraft", out, formats)
     for a, b, difference in comparisons:
         paths += plotting.compare_body(
             trajs[a],
