@@ -47,7 +47,8 @@ def problems(name: str) -> list[str]:
     e = entry(name)
     if e is None:
         return [
-            f"scenario {name!r} has no gallery entry (docs/_static/gallery/{name}/entry.json): {how}"
+            f"scenario {name!r} has no gallery entry "
+            f"(docs/_static/gallery/{name}/entry.json): {how}"
         ]
     out = []
     for key in ("command", "thesis", "figures"):
