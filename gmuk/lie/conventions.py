@@ -159,7 +159,7 @@ def mrp_shadow(sigma: Any) -> FloatArray:
     Parameters
     ----------
     sigma : array_like (..., 3)
-        MRPs, each nonzero.
+        MRPs (dimensionless), each nonzero.
 
     Returns
     -------
