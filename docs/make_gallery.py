@@ -4,8 +4,8 @@
     python docs/make_gallery.py fcei smd-gt
 
 For each scenario, runs ``gmuk run NAME ARGS --out TMP``, copies the listed figures into
-``docs/_static/gallery/NAME/`` as PNGs of at most 150 kB (resized to 760 px wide, 96-colour
-palette) and writes ``entry.json`` (the command, the thesis figures, the captions), which the
+``docs/_static/gallery/NAME/`` as PNGs of at most 150 kB (resized to 760 px wide, 128-colour
+palette, fast octree: it keeps the axis colours apart) and writes ``entry.json`` (the command, the thesis figures, the captions), which the
 Sphinx extension ``docs/_ext/gmuk_gallery.py`` turns into the page ``gallery/NAME``. It also
 renders FCEI's ``view.html`` in headless Chromium into ``docs/_static/view_fcei.png`` (the
 README's picture). Run on demand, never in CI. A new scenario needs an entry in COMMANDS.
@@ -26,7 +26,7 @@ from PIL import Image
 DOCS = Path(__file__).resolve().parent
 STATIC = DOCS / "_static" / "gallery"
 WIDTH = 760
-COLOURS = 96
+COLOURS = 128
 
 _CH4 = [
     ("orbit_3d", "The orbit about the Moon, with the spacecraft's body axes at eight instants."),
@@ -165,7 +165,7 @@ def small_png(src: Path, dst: Path, colours: int = COLOURS) -> None:
     im = Image.open(src).convert("RGB")
     if im.width > WIDTH:
         im = im.resize((WIDTH, round(im.height * WIDTH / im.width)), Image.Resampling.LANCZOS)
-    im.quantize(colours, method=Image.Quantize.MEDIANCUT).save(dst, optimize=True)
+    im.quantize(colours, method=Image.Quantize.FASTOCTREE).save(dst, optimize=True)
 
 
 def screenshot(html: Path, png: Path) -> None:

@@ -170,7 +170,7 @@ def test_a_plugin_scenario_is_discovered_and_run(plugins, tmp_path, capsys):
     argv = ["run", "tumble", "--duration", "1", "--no-plots", "--out", str(out)]
     assert cli.main(argv) == 0
     assert json.loads((out / "summary.json").read_text())["options"]["duration"] == 1.0
-    assert not list(out.glob("*.png"))
+    assert not list(out.glob("*.png")) and not (out / "view.html").exists()  # --no-plots
 
 
 def test_broken_plugins_warn_and_are_skipped(plugins):
