@@ -4,11 +4,12 @@
     python docs/make_gallery.py fcei smd-gt
 
 For each scenario, runs ``gmuk run NAME ARGS --out TMP``, copies the listed figures into
-``docs/_static/gallery/NAME/`` as PNGs of at most 150 kB (resized to 760 px wide, 128-colour
-palette, fast octree: it keeps the axis colours apart) and writes ``entry.json`` (the command, the thesis figures, the captions), which the
-Sphinx extension ``docs/_ext/gmuk_gallery.py`` turns into the page ``gallery/NAME``. It also
-renders FCEI's ``view.html`` in headless Chromium into ``docs/_static/view_fcei.png`` (the
-README's picture). Run on demand, never in CI. A new scenario needs an entry in COMMANDS.
+``docs/_static/gallery/NAME/`` as PNGs of at most 150 kB (resized to 760 px wide, a
+128-colour palette by fast octree, which keeps the axis colours apart) and writes
+``entry.json`` (the command, the thesis figures, the captions), which the Sphinx extension
+``docs/_ext/gmuk_gallery.py`` turns into the page ``gallery/NAME``. It also renders FCEI's
+``view.html`` in headless Chromium into ``docs/_static/view_fcei.png`` (the README's
+picture). Run on demand, never in CI. A new scenario needs an entry in COMMANDS.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+import numpy as np
 from PIL import Image
 
 DOCS = Path(__file__).resolve().parent
@@ -168,6 +170,18 @@ def small_png(src: Path, dst: Path, colours: int = COLOURS) -> None:
     im.quantize(colours, method=Image.Quantize.FASTOCTREE).save(dst, optimize=True)
 
 
+def picture(src: Path, dst: Path) -> None:
+    """A screenshot without the blank rows below the page's content and its scroll bar,
+    resized to WIDTH px, in full colour (the shaded sphere bands in a palette)."""
+    im = Image.open(src).convert("RGB")
+    ink = np.asarray(im)[:, :-24].min(axis=2) < 235  # not white (scroll bar left out)
+    rows = np.flatnonzero(ink.any(axis=1))
+    im = im.crop((0, 0, im.width - 20, min(im.height, int(rows[-1]) + 16)))
+    if im.width > WIDTH:
+        im = im.resize((WIDTH, round(im.height * WIDTH / im.width)), Image.Resampling.LANCZOS)
+    im.save(dst, optimize=True)
+
+
 def screenshot(html: Path, png: Path) -> None:
     """Headless Chromium's picture of a view (the flags of tests/test_view.py)."""
     with tempfile.TemporaryDirectory() as profile:
@@ -213,7 +227,7 @@ def make(name: str, work: Path) -> None:
     if name == "fcei":
         shot = work / "view.png"
         screenshot(out / "view.html", shot)
-        small_png(shot, DOCS / "_static" / "view_fcei.png", colours=256)
+        picture(shot, DOCS / "_static" / "view_fcei.png")
     print(f"{name}: {len(entries)} figure(s) in {dest}")
 
 
