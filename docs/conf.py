@@ -6,6 +6,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.abspath(".."))
+sys.path.insert(0, os.path.abspath("_ext"))  # gmuk_gallery: the gallery pages
 
 project = "gmuk"
 author = "gmuk developers"
@@ -17,6 +18,7 @@ extensions = [
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
     "sphinx.ext.viewcode",
+    "gmuk_gallery",
 ]
 napoleon_numpy_docstring = True
 napoleon_google_docstring = False

@@ -131,7 +131,7 @@ __all__ = [
 ]
 
 #: Submodules imported on first use (they pull in matplotlib, Pinocchio or the CLI).
-_LAZY = ("cli", "plotting", "scenarios")
+_LAZY = ("cli", "plotting", "scenarios", "view")
 
 
 def __getattr__(name: str) -> object:

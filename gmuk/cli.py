@@ -6,6 +6,7 @@
     gmuk run [NAME] --resume DIR
     gmuk run NAME --help
     gmuk check [--seed S] [--samples N] [--verbose]
+    gmuk view RUN_DIR_or_FILE.npz [--out FILE.html] [--central-radius M] [--max-frames N]
 
 ``gmuk run`` writes ``DIR/trajectory.npz`` (loadable with :func:`gmuk.load_trajectory`),
 ``DIR/summary.json`` with the headline figures, the figures, and whatever further data the
@@ -21,6 +22,9 @@ reached) are written and the exit status is 130 or 143. Every simulation writes 
 into ``DIR/.checkpoints`` every ``--checkpoint-every`` seconds (default 60), so a killed
 process (SIGKILL, a power cut) loses at most one interval; ``gmuk run --resume DIR`` continues
 the run with the options it was started with. A run that completes removes its checkpoints.
+
+``gmuk view`` writes an interactive 3-D view of a run (:mod:`gmuk.view`): one HTML file that
+opens offline in a browser. ``gmuk run`` writes it as ``DIR/view.html`` unless ``--no-plots``.
 
 ``gmuk check`` prints the table of :func:`gmuk.check <gmuk.crosscheck.check>` and exits 0 if
 every quantity agrees with Pinocchio within its tolerance, 1 if any does not.
@@ -85,6 +89,7 @@ def _parser() -> argparse.ArgumentParser:
         "--samples", type=int, default=1000, help="samples per quantity (default 1000)"
     )
     check.add_argument("--verbose", action="store_true", help="print each row as computed")
+    _add_view_parser(sub)
     return p
 
 
@@ -274,6 +279,8 @@ def _run(argv: Sequence[str]) -> int:
     with _stopping_signals(control) as received:  # a signal now ends the run after this step
         extra = scenario.write_data(result, out) if scenario.write_data is not None else []
         figures = [] if args.no_plots or received else scenario.figures(result, out, formats)
+        if not (args.no_plots or received):
+            figures.append(_write_run_view(primary, out, scenario))
     if received:
         print(
             f"{result.name}: stopped by {signal.Signals(received[0]).name} after the run "
@@ -300,6 +307,99 @@ def _check(args: argparse.Namespace) -> int:
     return 0 if report.ok else 1
 
 
+# --- gmuk view ----------------------------------------------------------------------------------
+
+
+def _add_view_parser(sub: Any) -> None:
+    view = sub.add_parser(
+        "view",
+        help="write an interactive 3-D view of a run (one HTML file that opens offline)",
+        description="Write a self-contained HTML page showing the central body, each body's "
+        "path in N and its axes triad moving along it (time slider and play button). It "
+        "makes no network request: open it from disk in any browser.",
+    )
+    view.add_argument(
+        "path", type=Path, metavar="RUN_DIR_or_FILE.npz", help="a gmuk run folder or a .npz"
+    )
+    view.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        metavar="FILE.html",
+        help="output file (default: RUN_DIR/view.html, or FILE.html beside FILE.npz)",
+    )
+    view.add_argument(
+        "--central-radius",
+        type=scenarios.positive_float,
+        default=None,
+        metavar="M",
+        help="radius of the central body sphere (m); default: the run's scenario's (from "
+        "RUN_DIR/summary.json), none for a bare .npz",
+    )
+    view.add_argument(
+        "--max-frames",
+        type=int,
+        default=150,
+        metavar="N",
+        help="most animation frames; longer runs are decimated (default: 150)",
+    )
+
+
+def _scenario_radius(name: object) -> float | None:
+    """The central radius (m) of the scenario called ``name``, None if unknown."""
+    try:
+        return scenarios.get(str(name)).central_radius
+    except GmukError:
+        return None
+
+
+def _view(args: argparse.Namespace) -> int:
+    from gmuk.trajectory import load_trajectory
+    from gmuk.view import write_view
+
+    path: Path = args.path
+    summary = path / "summary.json" if path.is_dir() else path.with_name("summary.json")
+    npz = path / "trajectory.npz" if path.is_dir() else path
+    if not npz.is_file():
+        raise OptionError(
+            f"gmuk view: expected a gmuk run folder (holding trajectory.npz) or a .npz file; "
+            f"got {str(path)!r} ({'no trajectory.npz in it' if path.is_dir() else 'no file'})"
+        )
+    if args.max_frames < 2:
+        raise OptionError(f"gmuk view: --max-frames must be an integer ≥ 2; got {args.max_frames}")
+    name = None
+    if path.is_dir() and summary.is_file():
+        try:
+            name = json.loads(summary.read_text()).get("scenario")
+        except (OSError, ValueError, AttributeError):
+            name = None
+    radius = args.central_radius
+    if radius is None and name is not None:
+        radius = _scenario_radius(name)
+    out = args.out or (path / "view.html" if path.is_dir() else npz.with_suffix(".html"))
+    written = write_view(
+        load_trajectory(npz),
+        out,
+        central_radius=radius,
+        title=f"gmuk: {name}" if name else f"gmuk: {npz.name}",
+        max_frames=args.max_frames,
+    )
+    print(f"wrote {written} (open it in a browser; it needs no network)")
+    return 0
+
+
+def _write_run_view(primary: Any, out: Path, scenario: Scenario) -> Path:
+    """``gmuk run``'s ``view.html`` of the primary run."""
+    from gmuk.view import write_view
+
+    return write_view(
+        primary,
+        out / "view.html",
+        central_radius=scenario.central_radius,
+        title=f"gmuk run {scenario.name}",
+    )
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``gmuk`` console script; returns the exit status (0 success, 1
     ``gmuk check`` found a disagreement, 2 bad input)."""
@@ -317,6 +417,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 0
         if args.command == "check":
             return _check(args)
+        if args.command == "view":
+            return _view(args)
         if args.command == "plugins":
             from gmuk.forces import registry
 

@@ -180,7 +180,9 @@ def kinetic_energy(V: Any, inertia: Any) -> FloatArray:
     Parameters
     ----------
     V : array_like, shape (..., 6)
+        Body twists [ω; v] (rad/s, m/s), body frame.
     inertia : array_like, shape (6, 6) or (..., 6, 6)
+        Mass–inertia tensor 𝕀 (kg·m², kg), body frame (:func:`spatial_inertia`).
 
     Returns
     -------

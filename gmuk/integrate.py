@@ -308,8 +308,8 @@ def simulate(
         Initial state; its ``t`` is replaced by ``t_span[0]``.
     t_span : (float, float)
         Start and end times (s), end > start.
-    t_eval : array_like, optional
-        Output times within t_span (increasing). Default: every accepted step.
+    t_eval : array_like, shape (k,), optional
+        Output times (s) within t_span (increasing). Default: every accepted step.
     method : str, RungeKuttaMethod subclass or instance
         The Runge–Kutta method (:mod:`gmuk.integrators`): a registered name,
         case-insensitive — ``"DOP853"`` (default), ``"DOPRI5"``, ``"RK4"`` or any name a

@@ -55,13 +55,15 @@ class InequalityKKT:
     constraint, side : str
     bound : float
         u or l (unit of h).
-    h : ndarray
+    t : ndarray (N,)
+        Output times (s).
+    h : ndarray (N,)
         The constrained function (``unit``).
-    g : ndarray
+    g : ndarray (N,)
         The KKT form ``g ≤ 0``: ``h − u`` or ``l − h`` (``unit``).
-    mu : ndarray
+    mu : ndarray (N,)
         The KKT multiplier μ = −σλ (``multiplier_unit``).
-    slack, slack_rate : ndarray
+    slack, slack_rate : ndarray (N,)
         The slack or excess coordinate w and its rate.
     unit, multiplier_unit : str
     """

@@ -26,6 +26,7 @@ __all__ = [
     "plot_components",
     "plot_kkt",
     "plot_log_lines",
+    "plot_orbit_3d",
     "plot_panels",
 ]
 
@@ -424,3 +425,91 @@ def plot_kkt(
     side = "h ≤ u" if kkt.side == "upper" else "h ≥ l"
     name = title or f"KKT conditions of {kkt.constraint} ({side}, bound {kkt.bound:g} {unit})"
     return plot_panels(kkt.t, panels, name, out, formats)
+
+
+def plot_orbit_3d(
+    traj: Trajectory,
+    body: str,
+    out: Path,
+    formats: Sequence[str] = ("png",),
+    *,
+    central_radius: float | None = None,
+    n_triads: int = 8,
+    triad_length: float | None = None,
+    title: str | None = None,
+) -> list[Path]:
+    """The path of one rigid body in N, in 3-D, with its axes triad at a few instants.
+
+    The triads are the columns of R_NB (body axes 1, 2, 3 in red, green, blue) drawn at
+    ``n_triads`` outputs evenly spaced in index, the first and last included; the central
+    body is a wireframe sphere at N's origin when ``central_radius`` is given. Lengths are
+    drawn in km when the scene is wider than 100 km, else in m; the axes have equal scale.
+
+    Parameters
+    ----------
+    traj : Trajectory
+    body : str
+        Name of a rigid body of ``traj``.
+    out : Path
+        Output path without suffix.
+    formats : sequence of str
+    central_radius : float, optional
+        Radius (m) of the central body.
+    n_triads : int
+        Number of instants with a triad (≥ 2).
+    triad_length : float, optional
+        Drawn length (m) of each axis; default 12 % of the scene's size.
+    title : str, optional
+
+    Returns
+    -------
+    list of Path
+    """
+    from gmuk.view import AXIS_COLOURS, KM_ABOVE_M, decimate
+
+    view = traj.body(body)
+    r_N, R_NB = view.position, view.R
+    size = max(float(np.ptp(r_N, axis=0).max()), 2.0 * (central_radius or 0.0))
+    size = size if size > 1e-6 else 1.0  # a body at rest: a 1 m scene
+    scale, unit = (1e-3, "km") if size > KM_ABOVE_M else (1.0, "m")
+    length = (triad_length if triad_length is not None else 0.12 * size) * scale
+    plt = _pyplot()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig = plt.figure(figsize=(6.5, 6.0), constrained_layout=True)
+    ax = fig.add_subplot(projection="3d")
+    if central_radius:
+        u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 36), np.linspace(0, np.pi, 18))
+        rs = central_radius * scale
+        ax.plot_wireframe(
+            rs * np.cos(u) * np.sin(v),
+            rs * np.sin(u) * np.sin(v),
+            rs * np.cos(v),
+            color="0.75",
+            lw=0.4,
+        )
+    p = r_N * scale
+    ax.plot(*p.T, color="0.25", lw=1.0, label=f"{body} path")
+    for n, i in enumerate(decimate(len(traj), max(2, n_triads))):
+        for k in range(3):
+            ax.quiver(
+                *p[i],
+                *(R_NB[i, :, k] * length),
+                color=AXIS_COLOURS[k],
+                lw=1.5,
+                arrow_length_ratio=0.15,
+                label=f"body axis {k + 1}" if n == 0 else None,
+            )
+    lo = p.min(axis=0) - length
+    hi = p.max(axis=0) + length
+    if central_radius:
+        lo, hi = np.minimum(lo, -central_radius * scale), np.maximum(hi, central_radius * scale)
+    ax.set_box_aspect(tuple(np.maximum(hi - lo, 1e-12)))
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_xlabel(f"x_N ({unit})")
+    ax.set_ylabel(f"y_N ({unit})")
+    ax.set_zlabel(f"z_N ({unit})")
+    ax.legend(loc="upper left", fontsize=8)
+    fig.suptitle(title or f"Orbit and attitude of {body} (N frame)")
+    return _save(plt, fig, out, formats)

@@ -89,6 +89,18 @@ def solve_sparse(
     solution of ``A M^{-1/2} y = r`` is computed by LSMR and ν̇_c = M^{-1/2} y. Agrees with
     :func:`solve_dense` to 1e-10.
 
+    Parameters
+    ----------
+    A : scipy.sparse matrix (s, n)
+        Constraint rows.
+    r : ndarray (s,)
+        ``b − A ν̇_a``, the constraint violation of the free acceleration (units of b).
+    Minv, Minv_sqrt : scipy.sparse matrix (n, n)
+        M⁻¹ and M^{-1/2} of the mass–inertia matrix (1/kg, 1/(kg·m²)).
+    method : {"lu", "cg"}
+    rtol : float
+        Relative tolerance of the conjugate-gradient solve.
+
     Returns
     -------
     (ν̇_c (n,), λ (s,), rank or None)
@@ -128,7 +140,16 @@ def solve_sparse(
 
 
 def matrix_power_spd(M: FloatArray, p: float) -> FloatArray:
-    """M^p of a symmetric positive-definite matrix (by eigendecomposition)."""
+    """M^p of a symmetric positive-definite matrix (by eigendecomposition).
+
+    Parameters
+    ----------
+    M : ndarray (n, n)
+        Symmetric positive definite, e.g. the mass–inertia matrix (kg, kg·m²); the result
+        has the units of M to the power p.
+    p : float
+        The power, e.g. −1/2 or −1/4.
+    """
     w, Q = np.linalg.eigh(M)
     return (Q * w**p) @ Q.T
 

@@ -170,7 +170,7 @@ def test_a_plugin_scenario_is_discovered_and_run(plugins, tmp_path, capsys):
     argv = ["run", "tumble", "--duration", "1", "--no-plots", "--out", str(out)]
     assert cli.main(argv) == 0
     assert json.loads((out / "summary.json").read_text())["options"]["duration"] == 1.0
-    assert not list(out.glob("*.png"))
+    assert not list(out.glob("*.png")) and not (out / "view.html").exists()  # --no-plots
 
 
 def test_broken_plugins_warn_and_are_skipped(plugins):
@@ -212,7 +212,8 @@ def test_gmuk_run_alone_runs_fcei_with_its_defaults(tmp_path, monkeypatch, capsy
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenario"] == "fcei" and summary["orbits"] == 1.0
     assert summary["options"] == {"orbits": 1.0}
-    assert len(list(out.glob("*.png"))) == 6
+    assert len(list(out.glob("*.png"))) == 7  # the six thesis groups and orbit_3d
+    assert (out / "view.html").is_file()
     assert "fcei (orbits=1.0)" in capsys.readouterr().out
 
 

@@ -43,6 +43,13 @@ def relative_twist(
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Relative pose and twist of B with respect to L.
 
+    Parameters
+    ----------
+    g_L, g_B : ndarray (4, 4)
+        Poses g_NL and g_NB of L and B in N (translation in m).
+    V_L, V_B : ndarray (6,)
+        Body twists [ω; v] of L (in L) and of B (in B) (rad/s, m/s).
+
     Returns
     -------
     g_BL : ndarray (4, 4)

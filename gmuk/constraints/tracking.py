@@ -37,7 +37,19 @@ _empty = np.empty
 
 def project_to_se3(X: FloatArray) -> FloatArray:
     """The se(3) part of a 4×4 matrix as a twist: skew part of the rotation block, and the
-    translation column; the last row is dropped. Shape (..., 4, 4) → (..., 6)."""
+    translation column; the last row is dropped.
+
+    Parameters
+    ----------
+    X : ndarray (..., 4, 4)
+        E.g. a pose derivative ġ or g̈ (rotation block in 1/s or 1/s², translation column
+        in m/s or m/s²; the result keeps those units).
+
+    Returns
+    -------
+    ndarray (..., 6)
+        ``[vee(skew(X[:3, :3])); X[:3, 3]]``.
+    """
     W = X[..., :3, :3]
     Ws = 0.5 * (W - np.swapaxes(W, -1, -2))
     return np.concatenate(
@@ -49,6 +61,13 @@ def tracking_errors(
     g: FloatArray, V: FloatArray, g_d: FloatArray, V_d: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
     """Configuration and velocity errors of a pose against a reference.
+
+    Parameters
+    ----------
+    g, g_d : ndarray (4, 4)
+        The pose g_NB and the reference pose (translation in m, in N).
+    V, V_d : ndarray (6,)
+        Their body twists [ω; v] (rad/s, m/s), each in its own body frame.
 
     Returns
     -------

@@ -92,10 +92,17 @@ KAPPA2_THESIS = -39.0 / 2.0
 
 
 def morse_s(E_R: FloatArray, a: FloatArray) -> FloatArray:
-    """``s(E_R) = Σᵢ aᵢ (E_Rᵀ eᵢ)^× eᵢ`` (McCann 2020, Eq. 84), shape (3,).
+    """``s(E_R) = Σᵢ aᵢ (E_Rᵀ eᵢ)^× eᵢ`` (McCann 2020, Eq. 84), shape (3,) (dimensionless).
 
     Zero exactly at the critical points of the Morse function ``tr(A − A E_R)``: E_R = I and,
     for distinct aᵢ, the three rotations by π about the axes eᵢ.
+
+    Parameters
+    ----------
+    E_R : ndarray (3, 3)
+        Attitude error R_nᵀ R (dimensionless rotation matrix).
+    a : ndarray (3,)
+        Morse weights, the diagonal of A (dimensionless, distinct and > 0).
     """
     # (E_Rᵀ eᵢ) is row i of E_R; Σ aᵢ uᵢ × eᵢ written out per component
     u = E_R * a[:, None]
@@ -103,7 +110,16 @@ def morse_s(E_R: FloatArray, a: FloatArray) -> FloatArray:
 
 
 def morse_s_rate_matrix(E_R: FloatArray, a: FloatArray) -> FloatArray:
-    """Q with ``ṡ = Q E_ω`` when ``Ė_R = E_R E_ω^``: ``Q = tr(A E_Rᵀ) I − E_Rᵀ A``, (3, 3)."""
+    """Q with ``ṡ = Q E_ω`` when ``Ė_R = E_R E_ω^``: ``Q = tr(A E_Rᵀ) I − E_Rᵀ A``, (3, 3)
+    (dimensionless; E_ω in rad/s gives ṡ in 1/s).
+
+    Parameters
+    ----------
+    E_R : ndarray (3, 3)
+        Attitude error R_nᵀ R (dimensionless rotation matrix).
+    a : ndarray (3,)
+        Morse weights, the diagonal of A (dimensionless).
+    """
     AEt = E_R.T * a[None, :]  # E_Rᵀ A
     return float(np.trace(AEt)) * _EYE3 - AEt
 

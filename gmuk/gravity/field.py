@@ -113,7 +113,7 @@ class SphericalHarmonicField:
         Highest degree N.
     C, S : ndarray, shape (N+1, N+1)
         4π-normalised coefficients (read-only).
-    sigma_C, sigma_S : ndarray or None
+    sigma_C, sigma_S : ndarray (N+1, N+1) or None
     name, reference, tide_system : str
     metadata : mapping
 

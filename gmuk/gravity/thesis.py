@@ -67,7 +67,7 @@ def thesis_eq26c_normalization(n: Any, p: Any) -> FloatArray:
     Parameters
     ----------
     n, p : int or array_like of int
-        Degree and order, 0 ≤ p ≤ n.
+        Degree and order, 0 ≤ p ≤ n (dimensionless; arrays broadcast together).
 
     Returns
     -------

@@ -230,6 +230,7 @@ def perifocal_state(p: Any, e: Any, nu: Any, mu: Any) -> tuple[FloatArray, Float
     """Position and velocity in the perifocal frame P.
 
     ``r_P = p/(1 + e cos ν) [cos ν, sin ν, 0]``, ``v_P = √(μ/p) [−sin ν, e + cos ν, 0]``.
+    The arguments broadcast together (scalars or arrays of one shape S).
 
     Parameters
     ----------

@@ -296,6 +296,9 @@ class Scenario:
     write_data : callable, optional
         ``write_data(result, out_dir) -> list[Path]``: writes further data files beside
         ``trajectory.npz`` and ``summary.json``.
+    central_radius : float, optional
+        Radius (m) of the central body the scenario's bodies orbit, drawn as a sphere by
+        the 3-D views (:mod:`gmuk.view`, ``gmuk view``); None when there is none.
     """
 
     name: str
@@ -304,6 +307,7 @@ class Scenario:
     figures: FigureFn
     options: tuple[Option, ...] = ()
     write_data: DataFn | None = None
+    central_radius: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "options", tuple(self.options))
@@ -327,6 +331,9 @@ class Scenario:
                 problems.append(f"{label} must be callable")
         if self.write_data is not None and not callable(self.write_data):
             problems.append("write_data must be callable or None")
+        r = self.central_radius
+        if r is not None and not (isinstance(r, (int, float)) and 0 < r < float("inf")):
+            problems.append(f"central_radius must be a finite number > 0 (m) or None; got {r!r}")
         if problems:
             raise DefinitionError([f"scenario {self.name!r}: {p}" for p in problems])
 

@@ -18,6 +18,7 @@ import numpy as np
 import gmuk
 from gmuk import plotting
 from gmuk._validation import FloatArray
+from gmuk.celestial import MOON_RADIUS
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3
 from gmuk.orbits import MU_MOON_THESIS_CONSISTENT, KeplerOrbit, LVLHReference
@@ -34,6 +35,8 @@ LM_INERTIA = np.array(
     ]
 )
 MU = MU_MOON_THESIS_CONSISTENT
+#: Radius of the Moon (m), the central body of every orbit scenario (drawn by the 3-D views).
+CENTRAL_RADIUS = MOON_RADIUS
 #: Integration tolerances for every Chapter 4 scenario: tight enough that FCEI's position error
 #: over one orbit stays well below the 1e-6 m target (rtol 1e-13 comes too close to it; the
 #: figures and the command that measures them are in docs/scenarios/chapter4.rst and
@@ -207,11 +210,13 @@ def figures_for(
     comparisons: Sequence[tuple[str, str, bool]] = (),
 ) -> list[Path]:
     """The thesis figure groups of the primary run, and for each (a, b, difference) in
-    ``comparisons`` the difference a − b (or both overlaid) of the spacecraft."""
+    ``comparisons`` the difference a − b (or both overlaid) of the spacecraft, and the 3-D
+    orbit with attitude triads (``orbit_3d``)."""
     trajs = result.trajectories
     paths = plotting.plot_body(
         trajs[result.primary], "spacecraft", out, formats, label=result.primary.upper()
     )
+    paths += orbit_figure(result, "spacecraft", out, formats)
     for a, b, difference in comparisons:
         paths += plotting.compare_body(
             trajs[a],
@@ -223,3 +228,18 @@ def figures_for(
             difference=difference,
         )
     return paths
+
+
+def orbit_figure(
+    result: ScenarioResult, body: str, out: Path, formats: Sequence[str]
+) -> list[Path]:
+    """``orbit_3d``: the primary run's orbit of ``body`` about the Moon, in 3-D, with its
+    attitude triads at eight instants (:func:`gmuk.plotting.plot_orbit_3d`)."""
+    return plotting.plot_orbit_3d(
+        result.trajectories[result.primary],
+        body,
+        out / "orbit_3d",
+        formats,
+        central_radius=CENTRAL_RADIUS,
+        title=f"{result.name.upper()}: orbit and attitude triads (N frame)",
+    )

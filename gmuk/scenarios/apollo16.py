@@ -501,6 +501,7 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
             out / "magnitudes_correct_vs_thesis",
             formats,
         )
+    paths += common.orbit_figure(result, BODY, out, formats)
     return paths
 
 
@@ -563,4 +564,5 @@ SCENARIO = Scenario(
         Option("rtol", positive_float, RTOL, "integrator tolerance, rtol = atol"),
     ),
     write_data=write_data,
+    central_radius=common.CENTRAL_RADIUS,
 )

@@ -697,6 +697,7 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
                 formats,
                 t_scale="symlog",
             )
+    paths += common.orbit_figure(result, BODY, out, formats)
     return paths
 
 
@@ -721,4 +722,5 @@ SCENARIO = Scenario(
             "integral gain k_I of the controller (1/s²); 0 removes the integral term",
         ),
     ),
+    central_radius=common.CENTRAL_RADIUS,
 )

@@ -79,7 +79,7 @@ from gmuk.scenarios import (
     positive_float,
 )
 from gmuk.scenarios._fields import DEFAULT_FIELD, harmonic_degree, lunar_field
-from gmuk.scenarios._lvlh import output_count
+from gmuk.scenarios._lvlh import CENTRAL_RADIUS, output_count
 
 NAME = "maintenance"
 DESCRIPTION = "trajectory maintenance within δ of a two-body reference, GRAIL field (§6.5.2)"
@@ -401,4 +401,5 @@ SCENARIO = Scenario(
             "also run the position bound alone and the free drift over the same span",
         ),
     ),
+    central_radius=CENTRAL_RADIUS,
 )

@@ -35,4 +35,11 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
     return common.figures_for(result, out, formats, [(NAME, "fcei", False)])
 
 
-SCENARIO = Scenario(NAME, DESCRIPTION, run, figures, options=(common.ORBITS,))
+SCENARIO = Scenario(
+    NAME,
+    DESCRIPTION,
+    run,
+    figures,
+    options=(common.ORBITS,),
+    central_radius=common.CENTRAL_RADIUS,
+)

@@ -441,6 +441,7 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
             out / f"unmodeled_{key.split('_')[0]}_deviation",
             formats,
         )
+    paths += common.orbit_figure(result, BODY, out, formats)
     return paths
 
 
@@ -470,4 +471,5 @@ SCENARIO = Scenario(
         ),
         Option("rtol", positive_float, RTOL, "controlled-run DOPRI5 tolerance, rtol = atol"),
     ),
+    central_radius=common.CENTRAL_RADIUS,
 )

@@ -183,7 +183,7 @@ def test_figures_and_data_are_written(short, tmp_path):
             for m in ("correct", "thesis")
             for k in ("1_position", "2_velocity", "3_euler321", "4_angular_velocity")
         ]
-        + ["magnitudes_correct_vs_thesis.png"]
+        + ["magnitudes_correct_vs_thesis.png", "orbit_3d.png"]
     )
     assert all(p.is_file() and p.stat().st_size > 10_000 for p in paths)
     data = apollo16.write_data(short, tmp_path)

@@ -83,7 +83,8 @@ def test_cli_list_and_run_write_trajectory_summary_and_figures(tmp_path, capsys)
     assert "spacecraft" in traj.body_names
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenario"] == "fcei" and summary["max_position_error_m"] < 1e-6
-    assert len(list(out.glob("*.png"))) == 6 and len(list(out.glob("*.pdf"))) == 6
+    # the six thesis figure groups and the 3-D orbit with attitude triads (orbit_3d)
+    assert len(list(out.glob("*.png"))) == 7 and len(list(out.glob("*.pdf"))) == 7
 
 
 def test_cli_reports_bad_input_clearly(capsys):

@@ -175,7 +175,7 @@ def test_cli_runs_both_scenarios_and_writes_summaries_and_figures(tmp_path):
     assert summary["degree"] == 3 and "controlled_max_position_deviation_m" in summary
     names = {p.stem for p in out.glob("*.png")}
     assert {f"fig5_{k}" for k in ("11_position", "16_ml_translational_control")} <= names
-    assert "unmodeled_position_deviation" in names and len(names) == 10
+    assert "unmodeled_position_deviation" in names and "orbit_3d" in names and len(names) == 11
 
 
 def test_fccl_figures_with_the_baumgarte_runs(tmp_path):

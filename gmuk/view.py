@@ -1,0 +1,334 @@
+"""Interactive 3-D views of a trajectory: one self-contained HTML file that opens offline.
+
+:func:`view_html` draws, with plotly, the central body as a sphere (when its radius is
+given), each body's path in the inertial frame N, and an animation (play button and time
+slider) of each rigid body's axes triad, the columns of R_NB, moving along its path; point
+masses are drawn as markers. :func:`write_view` writes the HTML to a file; ``gmuk view`` and
+``gmuk run`` (``view.html`` beside the figures) call it.
+
+Why plotly and not meshcat
+--------------------------
+The file must open from disk with no server process and no network. Plotly's
+``Figure.to_html(include_plotlyjs=True)`` embeds plotly.js (4.8 MB) in the page and
+needs nothing else: the file is the whole view, and the Python side is a pure-Python package
+with no running process. Meshcat's static-HTML export asks a running meshcat server
+(a ZeroMQ subprocess) for the scene, so producing a file needs a server process. Plotly's
+3-D scenes use WebGL, which every current browser has (headless Chromium renders it in
+software).
+
+File size
+---------
+The page is plotly.js plus the data. The data are decimated so that a long run stays small:
+each path is drawn through at most ``max_path_points`` samples (default 2000) and the
+animation has at most ``max_frames`` frames (default 150), both taken evenly spaced in the
+output index (the outputs of a gmuk run are evenly spaced in time), always keeping the first
+and last outputs. A view of one body is then about 5.1 MB whatever the run's length (a
+one-orbit FCEI run, 721 outputs: 5.06 MB).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray
+from gmuk.errors import DefinitionError
+from gmuk.trajectory import Trajectory, write_text_atomic
+
+__all__ = ["decimate", "view_html", "write_view"]
+
+#: Colours of body axes 1, 2, 3 (red, green, blue, as in most 3-D tools).
+AXIS_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
+#: Colour of the central body's sphere.
+SPHERE_COLOUR = "#9a9a9a"
+#: A scene wider than this (m) is drawn in km.
+KM_ABOVE_M = 1.0e5
+
+
+def decimate(n: int, most: int) -> np.ndarray:
+    """At most ``most`` indices into ``n`` outputs, evenly spaced, first and last kept.
+
+    Parameters
+    ----------
+    n : int
+        Number of outputs (≥ 1).
+    most : int
+        Largest number of indices to keep (≥ 2).
+
+    Returns
+    -------
+    ndarray (k,) of int
+        Increasing indices, ``k = min(n, most)``.
+    """
+    if n < 1:
+        raise DefinitionError(f"a view needs at least one output; got {n}")
+    if most < 2:
+        raise DefinitionError(f"the number of outputs to keep must be ≥ 2; got {most}")
+    if n <= most:
+        return np.arange(n)
+    return np.unique(np.round(np.linspace(0, n - 1, most)).astype(np.int64))
+
+
+def _positions(traj: Trajectory) -> list[tuple[str, FloatArray, FloatArray | None]]:
+    """(name, r_N (N, 3) in m, R_NB (N, 3, 3) or None) of every rigid body and point mass."""
+    out: list[tuple[str, FloatArray, FloatArray | None]] = []
+    for name, kind in zip(traj.body_names, traj.body_kinds, strict=True):
+        view = traj.body(name)
+        if kind == "rigid":
+            out.append((name, view.position, view.R))
+        elif kind == "point":
+            out.append((name, view.position, None))
+    return out
+
+
+def _segments(starts: FloatArray, ends: FloatArray) -> tuple[list[Any], list[Any], list[Any]]:
+    """x, y, z lists of line segments start→end (k, 3), separated by None for plotly."""
+    xs: list[Any] = []
+    ys: list[Any] = []
+    zs: list[Any] = []
+    for a, b in zip(starts, ends, strict=True):
+        xs += [float(a[0]), float(b[0]), None]
+        ys += [float(a[1]), float(b[1]), None]
+        zs += [float(a[2]), float(b[2]), None]
+    return xs, ys, zs
+
+
+def view_html(
+    traj: Trajectory,
+    *,
+    central_radius: float | None = None,
+    title: str = "",
+    triad_length: float | None = None,
+    max_frames: int = 150,
+    max_path_points: int = 2000,
+) -> str:
+    """The HTML page of an interactive, offline 3-D view of ``traj``.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        Rigid bodies are drawn with their axes triads, point masses as markers; slack
+        coordinates are not drawn.
+    central_radius : float, optional
+        Radius (m) of the central body, drawn as a sphere at N's origin; none if None.
+    title : str
+        Heading of the view.
+    triad_length : float, optional
+        Length (m) of each drawn body axis; default 12 % of the scene's size (the bodies of
+        an orbit would be invisible at scale), the scene being 1 m across when the bodies do
+        not move.
+    max_frames : int
+        Most animation frames (≥ 2); see the module's notes on decimation.
+    max_path_points : int
+        Most samples per drawn path (≥ 2).
+
+    Returns
+    -------
+    str
+        A complete HTML document with plotly.js embedded: it makes no network request.
+
+    Raises
+    ------
+    DefinitionError
+        No rigid body or point mass to draw, an empty trajectory, or a radius or length
+        that is not a finite number > 0.
+    """
+    import plotly.graph_objects as go
+
+    bodies = _positions(traj)
+    if not bodies:
+        raise DefinitionError(
+            f"nothing to draw: the trajectory has no rigid body or point mass "
+            f"(bodies {list(traj.body_names)}, kinds {list(traj.body_kinds)})"
+        )
+    for label, value in (("central_radius", central_radius), ("triad_length", triad_length)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise DefinitionError(f"{label} must be a finite number > 0 (m); got {value!r}")
+    n = len(traj)
+    path_idx = decimate(n, max_path_points)
+    frame_idx = decimate(n, max_frames)
+
+    allpos = np.concatenate([r[path_idx] for _, r, _ in bodies])
+    size = float(np.ptp(allpos, axis=0).max()) if len(allpos) > 1 else 0.0
+    size = max(size, 2.0 * central_radius if central_radius else 0.0)
+    size = size if size > 1e-6 else 1.0  # bodies at rest: a 1 m scene
+    scale, unit = (1e-3, "km") if size > KM_ABOVE_M else (1.0, "m")
+    length = triad_length if triad_length is not None else 0.12 * size
+
+    traces: list[Any] = []
+    if central_radius:
+        u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 48), np.linspace(0, np.pi, 24))
+        rs = central_radius * scale
+        traces.append(
+            go.Surface(
+                x=rs * np.cos(u) * np.sin(v),
+                y=rs * np.sin(u) * np.sin(v),
+                z=rs * np.cos(v),
+                colorscale=[[0, SPHERE_COLOUR], [1, SPHERE_COLOUR]],
+                showscale=False,
+                opacity=1.0,
+                name="central body",
+                hoverinfo="skip",
+            )
+        )
+    for k, (name, r, _) in enumerate(bodies):
+        p = r[path_idx] * scale
+        traces.append(
+            go.Scatter3d(
+                x=p[:, 0],
+                y=p[:, 1],
+                z=p[:, 2],
+                mode="lines",
+                line={"color": "rgba(60,60,60,0.8)" if k == 0 else None, "width": 3},
+                name=f"{name} path",
+            )
+        )
+    first_dynamic = len(traces)
+
+    def dynamic(i: int) -> list[Any]:
+        """The triads (one trace per axis, all rigid bodies) and markers at output i."""
+        out = []
+        rigid = [(r[i], R[i]) for _, r, R in bodies if R is not None]
+        for axis in range(3):
+            if rigid:
+                starts = np.array([r for r, _ in rigid]) * scale
+                ends = starts + np.array([R[:, axis] for _, R in rigid]) * length * scale
+                x, y, z = _segments(starts, ends)
+            else:
+                x = y = z = []
+            out.append(
+                go.Scatter3d(
+                    x=x,
+                    y=y,
+                    z=z,
+                    mode="lines",
+                    line={"color": AXIS_COLOURS[axis], "width": 7},
+                    name=f"body axis {axis + 1}",
+                )
+            )
+        here = np.array([r[i] for _, r, _ in bodies]) * scale
+        out.append(
+            go.Scatter3d(
+                x=here[:, 0],
+                y=here[:, 1],
+                z=here[:, 2],
+                mode="markers+text",
+                marker={"size": 5, "color": "#111111"},
+                text=[name for name, _, _ in bodies],
+                textposition="top center",
+                name="bodies",
+            )
+        )
+        return out
+
+    n_dynamic = 4
+    names = [f"{traj.t[i]:.6g}" for i in frame_idx]
+    frames = [
+        go.Frame(
+            data=dynamic(int(i)),
+            traces=list(range(first_dynamic, first_dynamic + n_dynamic)),
+            name=label,
+        )
+        for i, label in zip(frame_idx, names, strict=True)
+    ]
+    step_args = {"frame": {"duration": 0, "redraw": True}, "mode": "immediate"}
+    fig = go.Figure(data=traces + dynamic(int(frame_idx[0])), frames=frames)
+    axis = {"showbackground": False, "gridcolor": "#dddddd", "zerolinecolor": "#bbbbbb"}
+    fig.update_layout(
+        title={"text": title or "gmuk trajectory", "x": 0.02},
+        paper_bgcolor="white",
+        margin={"l": 0, "r": 0, "t": 40, "b": 0},
+        legend={"x": 0.01, "y": 0.95},
+        scene={
+            "domain": {"x": [0.0, 1.0], "y": [0.12, 1.0]},  # the slider below it
+            "aspectmode": "data",
+            "camera": {"eye": {"x": 0.6, "y": -1.3, "z": 1.2}},
+            "xaxis": {**axis, "title": {"text": f"x_N ({unit})"}},
+            "yaxis": {**axis, "title": {"text": f"y_N ({unit})"}},
+            "zaxis": {**axis, "title": {"text": f"z_N ({unit})"}},
+        },
+        updatemenus=[
+            {
+                "type": "buttons",
+                "direction": "left",
+                "x": 0.02,
+                "y": 0.02,
+                "xanchor": "left",
+                "yanchor": "bottom",
+                "buttons": [
+                    {
+                        "label": "Play",
+                        "method": "animate",
+                        "args": [
+                            None,
+                            {
+                                "frame": {"duration": 60, "redraw": True},
+                                "fromcurrent": True,
+                                "transition": {"duration": 0},
+                            },
+                        ],
+                    },
+                    {
+                        "label": "Pause",
+                        "method": "animate",
+                        "args": [[None], {**step_args, "transition": {"duration": 0}}],
+                    },
+                ],
+            }
+        ],
+        sliders=[
+            {
+                "active": 0,
+                "x": 0.15,
+                "y": 0.02,
+                "font": {"color": "rgba(0,0,0,0)"},  # one tick per frame: no labels
+                "ticklen": 2,
+                "len": 0.83,
+                "yanchor": "bottom",
+                "currentvalue": {"prefix": "t = ", "suffix": " s", "font": {"color": "#333"}},
+                "steps": [
+                    {"label": label, "method": "animate", "args": [[label], step_args]}
+                    for label in names
+                ],
+            }
+        ],
+    )
+    html: str = fig.to_html(
+        include_plotlyjs=True,
+        include_mathjax=False,
+        full_html=True,
+        auto_play=False,  # start at t0; the Play button animates
+        default_height="92vh",
+        config={"displaylogo": False, "responsive": True},
+    )
+    return html
+
+
+def write_view(
+    traj: Trajectory,
+    path: str | Path,
+    *,
+    central_radius: float | None = None,
+    title: str = "",
+    **options: Any,
+) -> Path:
+    """Write :func:`view_html` of ``traj`` to ``path`` (atomically); returns the path.
+
+    Parameters
+    ----------
+    traj : Trajectory
+    path : str or Path
+        The ``.html`` file to write; its folder is made if missing.
+    central_radius : float, optional
+        Radius (m) of the central body sphere.
+    title : str
+    **options
+        ``triad_length`` (m), ``max_frames``, ``max_path_points``, as :func:`view_html`.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return write_text_atomic(
+        path, view_html(traj, central_radius=central_radius, title=title, **options)
+    )
