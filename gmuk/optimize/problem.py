@@ -656,6 +656,7 @@ class _Transcription:
         fn = ca.Function(
             "element", [Rin, Yk, Uk, THk, tk], [R_end, ca.vertcat(*outs), cost, *path]
         )
+        # MX: CasADi differentiates the element Function once, not every node's copy
         X = ca.MX.sym("x", self.n_x)
         Y = ca.reshape(X[: ny * N], ny, N)
         U = ca.reshape(X[ny * N : (ny + nu_) * N], nu_, N)
@@ -971,8 +972,13 @@ class _Transcription:
     def element_errors(self, result: OptimalControlResult) -> FloatArray:
         """Relative collocation-defect estimate of each element (see solve_adaptive)."""
         pb, mesh = self.problem, self.mesh
-        errors = np.zeros(mesh.n_elements)
         nr = pb.n_th // 3
+        # the nodal F and θ̇, in one batch
+        R_nodes = result.R_NB
+        F_nodes = self._rhs_batch(result.t, result.y, result.u, R_nodes)
+        per_element = []
+        pts_t, pts_y, pts_u, pts_R, pts_T = [], [], [], [], []
+        col = 0
         for k, p in enumerate(mesh.degrees):
             i0 = mesh.first_node(k)
             a, b = mesh.breaks[k], mesh.breaks[k + 1]
@@ -981,33 +987,54 @@ class _Transcription:
             z, wz = np.polynomial.legendre.leggauss(2 * p + 1)
             Ainteg = _integration_at(x_nodes, z)  # (m, p+1)
             L = _interp(x_nodes, z)
-            Yk = result.y[i0 : i0 + p + 1]
-            Uk = result.u[i0 : i0 + p + 1]
-            Rk = result.element_R[k]
+            Yk, Uk, Fk = result.y[i0 : i0 + p + 1], result.u[i0 : i0 + p + 1], F_nodes[i0 : i0 + p + 1]
             th_nodes = np.zeros((p + 1, pb.n_th))
-            th_nodes[1:] = result.theta[sum(mesh.degrees[:k]) : sum(mesh.degrees[:k]) + p]
-            Fk = np.zeros((p + 1, pb.n_y))
-            Tk = np.zeros((p + 1, pb.n_th))
-            for j in range(p + 1):
-                Rn = [Rk[b_] @ _so3.exp_numeric(th_nodes[j, 3 * b_ : 3 * b_ + 3])
-                      for b_ in range(nr)]
-                Fk[j] = self._rhs_num(a + 0.5 * h * (x_nodes[j] + 1), Yk[j], Uk[j], Rn)
-                Tk[j] = self._theta_rate_num(th_nodes[j], Yk[j])
+            th_nodes[1:] = result.theta[col : col + p]
+            col += p
+            Tk = np.array([self._theta_rate_num(th_nodes[j], Yk[j]) for j in range(p + 1)])
             Yz = Yk[0][None, :] + 0.5 * h * Ainteg @ Fk
             Tz = 0.5 * h * Ainteg @ Tk
-            Uz = L @ Uk
-            Fz_interp = L @ Fk
-            Tz_interp = L @ Tk
-            dz = np.zeros((z.size, pb.n_y + pb.n_th))
-            for m in range(z.size):
-                Rn = [Rk[b_] @ _so3.exp_numeric(Tz[m, 3 * b_ : 3 * b_ + 3]) for b_ in range(nr)]
-                Fm = self._rhs_num(a + 0.5 * h * (z[m] + 1), Yz[m], Uz[m], Rn)
-                dz[m, : pb.n_y] = Fz_interp[m] - Fm
-                dz[m, pb.n_y :] = Tz_interp[m] - self._theta_rate_num(Tz[m], Yz[m])
+            Rz = np.array([
+                [result.element_R[k][b_] @ _so3.exp_numeric(Tz[m, 3 * b_ : 3 * b_ + 3])
+                 for b_ in range(nr)] for m in range(z.size)
+            ]).reshape(z.size, nr, 3, 3)
+            pts_t.append(a + 0.5 * h * (z + 1.0))
+            pts_y.append(Yz)
+            pts_u.append(L @ Uk)
+            pts_R.append(Rz)
+            pts_T.append(np.array([self._theta_rate_num(Tz[m], Yz[m]) for m in range(z.size)]))
             scale = 1.0 + np.abs(np.concatenate([Yk, th_nodes], axis=1)).max(axis=0)
-            est = 0.5 * h * (wz @ np.abs(dz)) / scale
-            errors[k] = float(est.max())
+            per_element.append((h, wz, L @ Fk, L @ Tk, scale))
+        F_pts = self._rhs_batch(np.concatenate(pts_t), np.concatenate(pts_y),
+                                np.concatenate(pts_u), np.concatenate(pts_R))
+        errors = np.zeros(mesh.n_elements)
+        m0 = 0
+        for k, (h, wz, F_interp, T_interp, scale) in enumerate(per_element):
+            m = wz.size
+            d = np.concatenate([F_interp - F_pts[m0 : m0 + m], T_interp - pts_T[k]], axis=1)
+            m0 += m
+            errors[k] = float((0.5 * h * (wz @ np.abs(d)) / scale).max())
         return errors
+
+    def _rhs_batch(self, t: FloatArray, y: FloatArray, u: FloatArray, R: FloatArray) -> FloatArray:
+        """F at many points (n, n_y): one mapped CasADi call when the parts take a symbolic
+        time, else point by point."""
+        import casadi as ca
+
+        pb = self.problem
+        n, nr = t.size, pb.n_th // 3
+        try:
+            ts, ys, us = ca.SX.sym("t"), ca.SX.sym("y", pb.n_y), ca.SX.sym("u", pb.n_u)
+            Rs = ca.SX.sym("R", 3, 3 * nr)
+            fn = ca.Function("rhs", [ts, ys, us, Rs],
+                             [pb._rhs(ts, ys, us, [Rs[:, 3 * b : 3 * b + 3] for b in range(nr)])])
+        except DefinitionError:
+            return np.array([
+                self._rhs_num(float(t[i]), y[i], u[i], list(R[i])) for i in range(n)
+            ])
+        Rflat = np.transpose(R, (2, 0, 1, 3)).reshape(3, 3 * nr * n) if nr else np.zeros((3, 0))
+        out = fn.map(n)(t[None, :], y.T, u.T, Rflat)
+        return np.asarray(out).T
 
     def _rhs_num(self, t: float, y: FloatArray, u: FloatArray, Rs: Sequence[FloatArray]) -> Any:
         import casadi as ca
