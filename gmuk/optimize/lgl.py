@@ -59,9 +59,12 @@ MAX_DEGREE = 400
 
 
 def _degree(p: object) -> int:
-    if isinstance(p, (bool, np.bool_)) or operator.index(p) != p:  # type: ignore[call-overload]
-        raise DefinitionError(f"an LGL degree must be an integer ≥ 1; got {p!r}")
-    n = operator.index(p)  # type: ignore[call-overload]
+    try:
+        if isinstance(p, (bool, np.bool_)):
+            raise TypeError
+        n = operator.index(p)  # type: ignore[call-overload]
+    except TypeError:
+        raise DefinitionError(f"an LGL degree must be an integer ≥ 1; got {p!r}") from None
     if not 1 <= n <= MAX_DEGREE:
         raise DefinitionError(f"an LGL degree must be in [1, {MAX_DEGREE}]; got {n}")
     return n
