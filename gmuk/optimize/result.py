@@ -118,7 +118,9 @@ class PathConstraintResult:
         if self.kind != "inequality":
             return []
         out = []
-        mu_unit = f"{self.cost_unit}/({self.unit or 'unit of h'}·s)"
+        unit = self.unit or "unit of h"
+        mu_unit = (f"N²/(kg·{unit})" if self.cost_unit == "N²·s/kg"
+                   else f"{self.cost_unit}/({unit}·s)")
         for side, bound, sign in (("lower", self.lower, -1.0), ("upper", self.upper, 1.0)):
             if not np.isfinite(bound):
                 continue
