@@ -84,4 +84,4 @@ def theta_rate_numeric(theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """θ̇ = J_r(θ)⁻¹ ω (3,) for arrays."""
     _, _, c = coefficients(float(theta @ theta))
     tw = np.cross(theta, omega)
-    return omega + 0.5 * tw + c * np.cross(theta, tw)  # type: ignore[no-any-return]
+    return omega + 0.5 * tw + c * np.cross(theta, tw)

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import functools
 import operator
+from typing import Any
 
 import numpy as np
 
@@ -58,11 +59,11 @@ __all__ = [
 MAX_DEGREE = 400
 
 
-def _degree(p: object) -> int:
+def _degree(p: Any) -> int:
     try:
         if isinstance(p, (bool, np.bool_)):
             raise TypeError
-        n = operator.index(p)  # type: ignore[call-overload]
+        n = operator.index(p)
     except TypeError:
         raise DefinitionError(f"an LGL degree must be an integer ≥ 1; got {p!r}") from None
     if not 1 <= n <= MAX_DEGREE:

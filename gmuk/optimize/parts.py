@@ -92,7 +92,7 @@ def _ca() -> Any:
 def _lookup(part: Any, method: str) -> Callable[..., Any] | None:
     own = getattr(part, method, None)
     if callable(own):
-        return own  # type: ignore[no-any-return]
+        return own
     form = _FORMS.get((type(part), method))
     if form is not None:
         return lambda *args: form(part, *args)
@@ -130,8 +130,7 @@ def _call(fn: Callable[..., Any], args: tuple[Any, ...], who: str, fix: str) -> 
         raise
     except Exception as exc:  # a numeric method that cannot take symbols
         raise DefinitionError(
-            f"{who} cannot be evaluated with CasADi symbols ({type(exc).__name__}: {exc}); "
-            f"{fix}"
+            f"{who} cannot be evaluated with CasADi symbols ({type(exc).__name__}: {exc}); {fix}"
         ) from None
 
 
@@ -150,8 +149,9 @@ def force_terms(
     if coupled is not None:
         out = _call(coupled, (t, tuple(q), tuple(nu), tuple(bodies)), who, _FORCE_FIX)
         if len(out) != len(bodies):
-            raise DefinitionError(f"{who}: casadi_wrenches returned {len(out)} terms for "
-                                  f"{len(bodies)} bodies")
+            raise DefinitionError(
+                f"{who}: casadi_wrenches returned {len(out)} terms for {len(bodies)} bodies"
+            )
         return [_as_column(w, who, b.dof) for w, b in zip(out, bodies, strict=True)]
     if type(model).wrenches is not ForceModel.wrenches:
         raise DefinitionError(
@@ -163,14 +163,16 @@ def force_terms(
         method = "casadi_wrench" if body.kind is BodyKind.RIGID else "casadi_force"
         fn = _lookup(model, method)
         if fn is None:
-            raise DefinitionError(f"{who} has no CasADi form for {body.kind} body "
-                                  f"{body.name!r}; {_FORCE_FIX}")
+            raise DefinitionError(
+                f"{who} has no CasADi form for {body.kind} body {body.name!r}; {_FORCE_FIX}"
+            )
         terms.append(_as_column(_call(fn, (t, qi, vi, body), who, _FORCE_FIX), who, body.dof))
     return terms
 
 
-def inequality_value(c: InequalityConstraint, q: tuple[Any, ...], nu: tuple[Any, ...],
-                     t: float) -> Any:
+def inequality_value(
+    c: InequalityConstraint, q: tuple[Any, ...], nu: tuple[Any, ...], t: float
+) -> Any:
     """h(q, ν, t) of an inequality as a CasADi scalar."""
     who = f"inequality constraint {c.name!r} ({type(c).__name__})"
     fn = _lookup(c, "casadi_value") or c.value
@@ -189,7 +191,7 @@ def equality_residual(c: Any, q: tuple[Any, ...], nu: tuple[Any, ...], t: float)
 
 
 def constraint_kind(c: Any) -> str:
-    """"inequality", "holonomic" or "nonholonomic"; a DefinitionError for any other kind."""
+    """ "inequality", "holonomic" or "nonholonomic"; a DefinitionError for any other kind."""
     if isinstance(c, InequalityConstraint):
         return "inequality"
     if isinstance(c, HolonomicConstraint):

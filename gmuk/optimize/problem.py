@@ -170,8 +170,9 @@ class OptimalControlProblem:
         self._by_name = {p.body.name: p for p in plans}
         self.n_y, self.n_u, self.n_th = y, u, th
         self._forces = self._force_plan()
-        self._constraints = [(c, parts.constraint_kind(c), self._constraint_plans(c))
-                             for c in system.constraints]
+        self._constraints = [
+            (c, parts.constraint_kind(c), self._constraint_plans(c)) for c in system.constraints
+        ]
         self._M_inv = np.zeros((u, u))
         for p in plans:
             Minv = np.linalg.inv(p.body.mass_matrix())
@@ -252,28 +253,30 @@ class OptimalControlProblem:
             )
         for key, values in spec.items():
             for name, value in values.items():
-                p = self._by_name.get(name)
-                if p is None:
+                plan = self._by_name.get(name)
+                if plan is None:
                     raise DefinitionError(
                         f"final[{key!r}] names unknown body {name!r}; bodies are "
                         f"{sorted(self._by_name)}"
                     )
-                if p.rigid != (key in ("g", "V")):
+                if plan.rigid != (key in ("g", "V")):
                     raise DefinitionError(
                         f"final[{key!r}][{name!r}]: {key!r} is for "
                         f"{'rigid bodies' if key in ('g', 'V') else 'point masses'}; "
-                        f"{name!r} is a {p.body.kind} body"
+                        f"{name!r} is a {plan.body.kind} body"
                     )
                 if key == "g":
                     g = check_se3(value, f"final['g'][{name!r}]")
                     Rf[name] = g[:3, :3].copy()
-                    rows, vals = range(p.y, p.y + 3), g[:3, 3]
+                    rows, vals = range(plan.y, plan.y + 3), g[:3, 3]
                 elif key == "V":
                     vals = as_array(value, (6,), f"final['V'][{name!r}]", batch=False)
-                    rows = range(p.y + 3, p.y + 9)
+                    rows = range(plan.y + 3, plan.y + 9)
                 else:
                     vals = as_array(value, (3,), f"final[{key!r}][{name!r}]", batch=False)
-                    rows = range(p.y + (0 if key == "r" else 3), p.y + (3 if key == "r" else 6))
+                    rows = range(
+                        plan.y + (0 if key == "r" else 3), plan.y + (3 if key == "r" else 6)
+                    )
                 fixed.update({r: float(v) for r, v in zip(rows, vals, strict=True)})
         return fixed, Rf
 
@@ -337,7 +340,7 @@ class OptimalControlProblem:
         )
 
     # ------------------------------------------------------------------ dynamics
-    def _rhs(self, t: float, y: Any, u: Any, Rs: Sequence[Any]) -> Any:
+    def _rhs(self, t: Any, y: Any, u: Any, Rs: Sequence[Any]) -> Any:
         """F(t, y, u) (n_y × 1) for CasADi SX or DM columns y, u and attitudes Rs."""
         import casadi as ca
 
@@ -523,8 +526,15 @@ class OptimalControlProblem:
             errors = _Transcription(self, mesh, build=False).element_errors(result)
             emax = float(errors.max())
             history.append(
-                RefinementStep(rnd, mesh.n_elements, mesh.n_nodes, result.objective, emax,
-                               result.iterations, result.timings["total_s"])
+                RefinementStep(
+                    rnd,
+                    mesh.n_elements,
+                    mesh.n_nodes,
+                    result.objective,
+                    emax,
+                    result.iterations,
+                    result.timings["total_s"],
+                )
             )
             if emax <= tol:
                 break
@@ -642,7 +652,7 @@ class _Transcription:
             if j > 0:
                 for c_vals, v in zip(values, vals, strict=True):
                     c_vals.append(v)
-        x_nodes, w = lgl_nodes(p)
+        _x_nodes, w = lgl_nodes(p)
         h = tk[p] - tk[0]
         A = ca.DM(0.5 * np.asarray(lgl_integration_matrix(p))[1:].T)
         dyn = Yk[:, 1:] - ca.repmat(Yk[:, 0], 1, p) - h * (ca.horzcat(*Fs) @ A)
@@ -653,9 +663,7 @@ class _Transcription:
         path = [ca.vertcat(*v) for v in values]
         cost = 0.5 * h * (ca.horzcat(*Ls) @ ca.DM(w))
         R_end = ca.horzcat(*node_R[p]) if nr else ca.SX(3, 0)
-        fn = ca.Function(
-            "element", [Rin, Yk, Uk, THk, tk], [R_end, ca.vertcat(*outs), cost, *path]
-        )
+        fn = ca.Function("element", [Rin, Yk, Uk, THk, tk], [R_end, ca.vertcat(*outs), cost, *path])
         # MX: CasADi differentiates the element Function once, not every node's copy
         X = ca.MX.sym("x", self.n_x)
         Y = ca.reshape(X[: ny * N], ny, N)
@@ -675,8 +683,9 @@ class _Transcription:
         lbg, ubg = [0.0] * n_dyn, [0.0] * n_dyn
         self.path_rows: list[tuple[Any, str, np.ndarray, int, int]] = []
         row = n_dyn
-        for (c, kind, _), nodes, out in zip(pb._constraints, self._path_nodes, res[3:],
-                                            strict=True):
+        for (c, kind, _), nodes, out in zip(
+            pb._constraints, self._path_nodes, res[3:], strict=True
+        ):
             s = out.shape[0] // p
             block = ca.vec(out)[: s * nodes.size]  # nodes 1 … N−1 in order, s rows each
             lo, hi = self._path_bounds(c, kind)
@@ -690,7 +699,7 @@ class _Transcription:
         )
         lbg += [0.0] * att.shape[0]
         ubg += [0.0] * att.shape[0]
-        self.x = X
+        self.x: Any = X
         self.g = ca.vertcat(*g_blocks, att)
         if pb.cost is None:  # quadratic in U: one MX expression, outside the map
             self.f = ca.sum2(ca.sum1(U * (_dm(pb._M_inv) @ U)) * _dm(self.W).T)
@@ -755,8 +764,9 @@ class _Transcription:
         lbg, ubg = [0.0] * n_dyn, [0.0] * n_dyn
         self.path_rows = []
         row = n_dyn
-        for ci, ((c, kind, _), nodes) in enumerate(zip(pb._constraints, self._path_nodes,
-                                                       strict=True)):
+        for ci, ((c, kind, _), nodes) in enumerate(
+            zip(pb._constraints, self._path_nodes, strict=True)
+        ):
             if nodes.size == 0:
                 continue
             block = ca.vertcat(*[terms[i][1][ci] for i in nodes])
@@ -802,17 +812,18 @@ class _Transcription:
                     Yg[:, p.y + 3 : p.y + 6] = phi / (pb.tf - pb.t0)
         TH = np.zeros((pb.n_th, self.n_th_cols))
         col = 0
-        for k, p in enumerate(mesh.degrees):
+        for k, deg in enumerate(mesh.degrees):
             i0 = mesh.first_node(k)
-            for j in range(1, p + 1):
+            for j in range(1, deg + 1):
                 for b in range(pb.n_th // 3):
                     d = so3.log(_orthonormal(Rg[i0, b].T @ Rg[i0 + j, b]))
                     TH[3 * b : 3 * b + 3, col + j - 1] = np.clip(
                         d, -pb.max_element_rotation, pb.max_element_rotation
                     )
-            col += p
-        return np.concatenate([Yg.T.reshape(-1, order="F"), Ug.T.reshape(-1, order="F"),
-                               TH.reshape(-1, order="F")])
+            col += deg
+        return np.concatenate(
+            [Yg.T.reshape(-1, order="F"), Ug.T.reshape(-1, order="F"), TH.reshape(-1, order="F")]
+        )
 
     # ------------------------------------------------------------------ solve
     def solve(
@@ -873,8 +884,9 @@ class _Transcription:
         gval = np.asarray(out["g"]).reshape(-1)
         viol = float(np.maximum(np.maximum(self.lbg - gval, gval - self.ubg), 0.0).max(initial=0))
         iters = stats.get("iterations") or {}
-        history = {k: np.asarray(iters.get(k, []), dtype=float)
-                   for k in ("obj", "inf_pr", "inf_du", "mu")}
+        history = {
+            k: np.asarray(iters.get(k, []), dtype=float) for k in ("obj", "inf_pr", "inf_du", "mu")
+        }
         timings = {
             "transcription_s": transcription_s + setup,
             "solve_s": solve_s,
@@ -963,8 +975,11 @@ class _Transcription:
             log=text,
             path=paths,
             timings=timings,
-            stats={"constraint_violation": violation, "n_variables": int(x.size),
-                   "n_constraints": int(gval.size)},
+            stats={
+                "constraint_violation": violation,
+                "n_variables": int(x.size),
+                "n_constraints": int(gval.size),
+            },
             _kkt=_KKTEvaluator(self, x, lam_g, lam_x),
         )
 
@@ -987,17 +1002,26 @@ class _Transcription:
             z, wz = np.polynomial.legendre.leggauss(2 * p + 1)
             Ainteg = _integration_at(x_nodes, z)  # (m, p+1)
             L = _interp(x_nodes, z)
-            Yk, Uk, Fk = result.y[i0 : i0 + p + 1], result.u[i0 : i0 + p + 1], F_nodes[i0 : i0 + p + 1]
+            Yk, Uk, Fk = (
+                result.y[i0 : i0 + p + 1],
+                result.u[i0 : i0 + p + 1],
+                F_nodes[i0 : i0 + p + 1],
+            )
             th_nodes = np.zeros((p + 1, pb.n_th))
             th_nodes[1:] = result.theta[col : col + p]
             col += p
             Tk = np.array([self._theta_rate_num(th_nodes[j], Yk[j]) for j in range(p + 1)])
             Yz = Yk[0][None, :] + 0.5 * h * Ainteg @ Fk
             Tz = 0.5 * h * Ainteg @ Tk
-            Rz = np.array([
-                [result.element_R[k][b_] @ _so3.exp_numeric(Tz[m, 3 * b_ : 3 * b_ + 3])
-                 for b_ in range(nr)] for m in range(z.size)
-            ]).reshape(z.size, nr, 3, 3)
+            Rz = np.array(
+                [
+                    [
+                        result.element_R[k][b_] @ _so3.exp_numeric(Tz[m, 3 * b_ : 3 * b_ + 3])
+                        for b_ in range(nr)
+                    ]
+                    for m in range(z.size)
+                ]
+            ).reshape(z.size, nr, 3, 3)
             pts_t.append(a + 0.5 * h * (z + 1.0))
             pts_y.append(Yz)
             pts_u.append(L @ Uk)
@@ -1005,8 +1029,12 @@ class _Transcription:
             pts_T.append(np.array([self._theta_rate_num(Tz[m], Yz[m]) for m in range(z.size)]))
             scale = 1.0 + np.abs(np.concatenate([Yk, th_nodes], axis=1)).max(axis=0)
             per_element.append((h, wz, L @ Fk, L @ Tk, scale))
-        F_pts = self._rhs_batch(np.concatenate(pts_t), np.concatenate(pts_y),
-                                np.concatenate(pts_u), np.concatenate(pts_R))
+        F_pts = self._rhs_batch(
+            np.concatenate(pts_t),
+            np.concatenate(pts_y),
+            np.concatenate(pts_u),
+            np.concatenate(pts_R),
+        )
         errors = np.zeros(mesh.n_elements)
         m0 = 0
         for k, (h, wz, F_interp, T_interp, scale) in enumerate(per_element):
@@ -1026,12 +1054,13 @@ class _Transcription:
         try:
             ts, ys, us = ca.SX.sym("t"), ca.SX.sym("y", pb.n_y), ca.SX.sym("u", pb.n_u)
             Rs = ca.SX.sym("R", 3, 3 * nr)
-            fn = ca.Function("rhs", [ts, ys, us, Rs],
-                             [pb._rhs(ts, ys, us, [Rs[:, 3 * b : 3 * b + 3] for b in range(nr)])])
+            fn = ca.Function(
+                "rhs",
+                [ts, ys, us, Rs],
+                [pb._rhs(ts, ys, us, [Rs[:, 3 * b : 3 * b + 3] for b in range(nr)])],
+            )
         except DefinitionError:
-            return np.array([
-                self._rhs_num(float(t[i]), y[i], u[i], list(R[i])) for i in range(n)
-            ])
+            return np.array([self._rhs_num(float(t[i]), y[i], u[i], list(R[i])) for i in range(n)])
         Rflat = np.transpose(R, (2, 0, 1, 3)).reshape(3, 3 * nr * n) if nr else np.zeros((3, 0))
         out = fn.map(n)(t[None, :], y.T, u.T, Rflat)
         return np.asarray(out).T
@@ -1057,8 +1086,9 @@ class _KKTEvaluator:
     """The NLP's KKT residuals at the solution, computed on request (builds the gradient of
     the Lagrangian only then)."""
 
-    def __init__(self, tr: _Transcription, x: FloatArray, lam_g: FloatArray,
-                 lam_x: FloatArray) -> None:
+    def __init__(
+        self, tr: _Transcription, x: FloatArray, lam_g: FloatArray, lam_x: FloatArray
+    ) -> None:
         self.tr, self.x, self.lam_g, self.lam_x = tr, x, lam_g, lam_x
 
     def __call__(self) -> dict[str, float]:
@@ -1066,8 +1096,7 @@ class _KKTEvaluator:
 
         tr = self.tr
         lam = type(tr.x).sym("lam", tr.g.shape[0])
-        grad = ca.Function("grad_L", [tr.x, lam],
-                           [ca.gradient(tr.f + ca.dot(lam, tr.g), tr.x)])
+        grad = ca.Function("grad_L", [tr.x, lam], [ca.gradient(tr.f + ca.dot(lam, tr.g), tr.x)])
         gL = np.asarray(grad(self.x, self.lam_g)).reshape(-1) + self.lam_x
         grad_f = np.asarray(ca.Function("grad_f", [tr.x], [ca.gradient(tr.f, tr.x)])(self.x))
         gval = np.asarray(ca.Function("g", [tr.x], [tr.g])(self.x)).reshape(-1)
@@ -1134,4 +1163,3 @@ def _integration_at(x: FloatArray, y: FloatArray) -> FloatArray:
         integ = np.polynomial.legendre.legint(coef[:, j], lbnd=-1.0)
         out[:, j] = np.polynomial.legendre.legval(y, integ)
     return out
-

@@ -3,6 +3,7 @@ multipliers, KKT residuals, IPOPT's status and log, and an open-loop controller.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -119,8 +120,9 @@ class PathConstraintResult:
             return []
         out = []
         unit = self.unit or "unit of h"
-        mu_unit = (f"N²/(kg·{unit})" if self.cost_unit == "N²·s/kg"
-                   else f"{self.cost_unit}/({unit}·s)")
+        mu_unit = (
+            f"N²/(kg·{unit})" if self.cost_unit == "N²·s/kg" else f"{self.cost_unit}/({unit}·s)"
+        )
         for side, bound, sign in (("lower", self.lower, -1.0), ("upper", self.upper, 1.0)):
             if not np.isfinite(bound):
                 continue
@@ -129,8 +131,17 @@ class PathConstraintResult:
             # with both bounds one row carries both multipliers: each side takes its sign
             mu = np.maximum(lam, 0.0) if np.isfinite(other) else lam
             out.append(
-                BoundKKT(self.name, side, float(bound), self.t, self.value,
-                         sign * (self.value - bound), mu, self.unit, mu_unit)
+                BoundKKT(
+                    self.name,
+                    side,
+                    float(bound),
+                    self.t,
+                    self.value,
+                    sign * (self.value - bound),
+                    mu,
+                    self.unit,
+                    mu_unit,
+                )
             )
         return out
 
@@ -225,8 +236,9 @@ class OptimalControlResult:
         return out
 
     def _rows(self, kind: str, lo: int, hi: int) -> list[int]:
-        return [y + k for (kd, y, _, _) in self._slots().values() if kd == kind
-                for k in range(lo, hi)]
+        return [
+            y + k for (kd, y, _, _) in self._slots().values() if kd == kind for k in range(lo, hi)
+        ]
 
     @property
     def r_N(self) -> FloatArray:
@@ -261,10 +273,16 @@ class OptimalControlResult:
             raise DefinitionError(f"no body {name!r}; bodies are {list(self.body_names)}")
         kind, y, u, i = slots[name]
         if kind == "rigid":
-            return {"g_NB": self.g_NB[:, i], "V_B": self.y[:, y + 3 : y + 9],
-                    "u": self.u[:, u : u + 6]}
-        return {"r_N": self.y[:, y : y + 3], "v_N": self.y[:, y + 3 : y + 6],
-                "u": self.u[:, u : u + 3]}
+            return {
+                "g_NB": self.g_NB[:, i],
+                "V_B": self.y[:, y + 3 : y + 9],
+                "u": self.u[:, u : u + 6],
+            }
+        return {
+            "r_N": self.y[:, y : y + 3],
+            "v_N": self.y[:, y + 3 : y + 6],
+            "u": self.u[:, u : u + 3],
+        }
 
     # ------------------------------------------------------------------ interpolation
     def _per_element(self, t: Any, values: FloatArray) -> FloatArray:
@@ -275,8 +293,7 @@ class OptimalControlResult:
             tt > mesh.tf + 1e-9 * max(1.0, abs(mesh.tf))
         ):
             raise DefinitionError(
-                f"times must lie in [{mesh.t0:g}, {mesh.tf:g}] s; got "
-                f"[{tt.min():g}, {tt.max():g}]"
+                f"times must lie in [{mesh.t0:g}, {mesh.tf:g}] s; got [{tt.min():g}, {tt.max():g}]"
             )
         out = np.zeros((tt.size, values.shape[1]))
         elements = mesh.element_of(tt)
@@ -371,12 +388,11 @@ class OpenLoopControl(Controller):
         super().__init__(list(result.body_names), name=name)
         self.result = result
         offsets = np.concatenate([[0], np.cumsum(result.body_dofs)])
-        self._slices = [slice(int(a), int(b)) for a, b in zip(offsets[:-1], offsets[1:],
-                                                               strict=True)]
+        self._slices = [slice(int(a), int(b)) for a, b in itertools.pairwise(offsets)]
 
-    def control(self, state: State, z: FloatArray, *modeled: FloatArray) -> tuple[
-        Sequence[Any], Any
-    ]:
+    def control(
+        self, state: State, z: FloatArray, *modeled: FloatArray
+    ) -> tuple[Sequence[Any], Any]:
         """The interpolated controls at ``state.t``, one array per body."""
         u = self.result.control(state.t)
         return [u[s] for s in self._slices], np.zeros(0)

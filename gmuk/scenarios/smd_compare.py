@@ -42,8 +42,8 @@ from gmuk.scenarios import (
     comma_separated,
     non_negative_float,
     positive_float,
+    smd,
 )
-from gmuk.scenarios import smd
 
 NAME = "smd-compare"
 DESCRIPTION = "SMD: the UK slack answer beside the direct LGL optimum of the same model (§6.4)"
@@ -139,8 +139,15 @@ def compare_case(
         "trajectory": traj,
         "kkt_uk": kkt_uk,
         "direct": direct,
-        "grid": {"t": t, "x_uk": x_uk, "x_direct": x_d, "v_uk": v_uk, "v_direct": v_d,
-                 "u_uk": u_uk, "u_direct": u_d},
+        "grid": {
+            "t": t,
+            "x_uk": x_uk,
+            "x_direct": x_d,
+            "v_uk": v_uk,
+            "v_direct": v_d,
+            "u_uk": u_uk,
+            "u_direct": u_d,
+        },
         "summary": summary,
     }
 
@@ -157,8 +164,9 @@ def run(
     if unknown or not cases:
         raise OptionError(f"--cases takes names from {sorted(smd.CASES)}; got {list(cases)}")
     if elements < 1 or not 1 <= degree <= 40:
-        raise OptionError(f"--elements must be ≥ 1 and --degree in [1, 40]; got {elements}, "
-                          f"{degree}")
+        raise OptionError(
+            f"--elements must be ≥ 1 and --degree in [1, 40]; got {elements}, {degree}"
+        )
     data = {c: compare_case(c, duration, elements, degree, refine_tol) for c in cases}
     summary = {c: d["summary"] for c, d in data.items()}
     primary = "smd-bi" if "smd-bi" in data else cases[0]
@@ -173,13 +181,12 @@ def write_data(result: ScenarioResult, out: Path) -> list[Path]:
     paths = []
     for case, d in result.data.items():
         direct = d["direct"]
-        arrays = {"t": direct.t, "r_N": direct.r_N[:, 0], "v_N": direct.v_N[:, 0],
-                  "u": direct.u}
+        arrays = {"t": direct.t, "r_N": direct.r_N[:, 0], "v_N": direct.v_N[:, 0], "u": direct.u}
         for name, b in direct.kkt().items():
             arrays[f"mu_{name}_t"] = b.t
             arrays[f"mu_{name}"] = b.mu
         path = out / f"direct_{case}.npz"
-        np.savez_compressed(path, **arrays)  # type: ignore[arg-type]
+        np.savez_compressed(path, **arrays)
         paths.append(path)
     return paths
 
@@ -195,8 +202,14 @@ def _panels(
 
     plt = plotting._pyplot()
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig, axes = plt.subplots(len(panels), 1, sharex=True, squeeze=False,
-                             figsize=(7.0, 1.7 * len(panels) + 0.9), constrained_layout=True)
+    fig, axes = plt.subplots(
+        len(panels),
+        1,
+        sharex=True,
+        squeeze=False,
+        figsize=(7.0, 1.7 * len(panels) + 0.9),
+        constrained_layout=True,
+    )
     for ax, (ylabel, lines) in zip(axes[:, 0], panels, strict=True):
         for label, t, y, style in lines:
             ax.plot(t, y, label=label, **{"lw": 1.1, **style})
@@ -212,55 +225,107 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
     """Per case: position, velocity, control, control effort, multipliers, KKT (thesis
     Figures 6.20–6.27), UK slack (C0) against the direct optimum (C1)."""
     paths: list[Path] = []
-    uk = {"color": "C0"}
-    dr = {"color": "C1", "linestyle": "--"}
-    bound = {"color": "0.4", "linestyle": ":", "lw": 0.9}
+    uk: dict[str, Any] = {"color": "C0"}
+    dr: dict[str, Any] = {"color": "C1", "linestyle": "--"}
+    bound: dict[str, Any] = {"color": "0.4", "linestyle": ":", "lw": 0.9}
     for case, d in result.data.items():
         g = d["grid"]
         t = g["t"]
         direct = d["direct"]
         label = f"{case.upper()} ({smd.CASES[case][4]})"
         where = out / case
-        lines = [("UK slack", t, g["x_uk"], uk), ("direct optimum", t, g["x_direct"], dr)]
-        lines += [(f"bound {b.bound:g} m", t, np.full_like(t, b.bound), bound)
-                  for b in direct.kkt().values()]
-        paths += _panels([("x (m)", lines)],
-                         f"{label}: position (cf. thesis Fig. {FIGURES['position']})",
-                         where / "position", formats)
-        paths += _panels([("ẋ (m/s)", [("UK slack", t, g["v_uk"], uk),
-                                       ("direct optimum", t, g["v_direct"], dr)])],
-                         f"{label}: velocity (cf. Fig. {FIGURES['velocity']})",
-                         where / "velocity", formats)
-        paths += _panels([("u (m/s²)", [("UK slack", t, g["u_uk"], uk),
-                                        ("direct optimum", t, g["u_direct"], dr)])],
-                         f"{label}: control acceleration (cf. Fig. {FIGURES['control']})",
-                         where / "control", formats)
-        paths += _panels([("∫|u| dt (m/s)",
-                           [("UK slack", t, _cumulative(np.abs(g["u_uk"]), t), uk),
-                            ("direct optimum", t, _cumulative(np.abs(g["u_direct"]), t), dr)])],
-                         f"{label}: control effort (cf. Fig. {FIGURES['effort']})",
-                         where / "effort", formats)
+        lines: list[tuple[str, Any, Any, dict[str, Any]]] = [
+            ("UK slack", t, g["x_uk"], uk),
+            ("direct optimum", t, g["x_direct"], dr),
+        ]
+        lines += [
+            (f"bound {b.bound:g} m", t, np.full_like(t, b.bound), bound)
+            for b in direct.kkt().values()
+        ]
+        paths += _panels(
+            [("x (m)", lines)],
+            f"{label}: position (cf. thesis Fig. {FIGURES['position']})",
+            where / "position",
+            formats,
+        )
+        paths += _panels(
+            [
+                (
+                    "ẋ (m/s)",
+                    [("UK slack", t, g["v_uk"], uk), ("direct optimum", t, g["v_direct"], dr)],
+                )
+            ],
+            f"{label}: velocity (cf. Fig. {FIGURES['velocity']})",
+            where / "velocity",
+            formats,
+        )
+        paths += _panels(
+            [
+                (
+                    "u (m/s²)",
+                    [("UK slack", t, g["u_uk"], uk), ("direct optimum", t, g["u_direct"], dr)],
+                )
+            ],
+            f"{label}: control acceleration (cf. Fig. {FIGURES['control']})",
+            where / "control",
+            formats,
+        )
+        paths += _panels(
+            [
+                (
+                    "∫|u| dt (m/s)",
+                    [
+                        ("UK slack", t, _cumulative(np.abs(g["u_uk"]), t), uk),
+                        ("direct optimum", t, _cumulative(np.abs(g["u_direct"]), t), dr),
+                    ],
+                )
+            ],
+            f"{label}: control effort (cf. Fig. {FIGURES['effort']})",
+            where / "effort",
+            formats,
+        )
         kkt_uk = d["kkt_uk"].inequalities
         side_color = {"lower": "C2", "upper": "C3"}
-        mu_uk = [(f"UK μ, {b.side} bound", t, b.mu, {"color": side_color[b.side]})
-                 for b in kkt_uk.values()]
+        mu_uk = [
+            (f"UK μ, {b.side} bound", t, b.mu, {"color": side_color[b.side]})
+            for b in kkt_uk.values()
+        ]
         kd = direct.kkt()
-        mu_d = [(f"direct μ, {b.side} bound", b.t, b.mu,
-                 {"color": side_color[b.side], "linestyle": "--"}) for b in kd.values()]
+        mu_d = [
+            (
+                f"direct μ, {b.side} bound",
+                b.t,
+                b.mu,
+                {"color": side_color[b.side], "linestyle": "--"},
+            )
+            for b in kd.values()
+        ]
         unit_d = next(iter(kd.values())).multiplier_unit if kd else ""
-        paths += _panels([("UK μ (N)", mu_uk), (f"direct μ ({unit_d})", mu_d)],
-                         f"{label}: multipliers (cf. Figs. {FIGURES['multipliers']})",
-                         where / "multipliers", formats)
+        paths += _panels(
+            [("UK μ (N)", mu_uk), (f"direct μ ({unit_d})", mu_d)],
+            f"{label}: multipliers (cf. Figs. {FIGURES['multipliers']})",
+            where / "multipliers",
+            formats,
+        )
         panels = []
         direct_by_side = {b.side: b for b in kd.values()}
         for b_uk in kkt_uk.values():
             b_d = direct_by_side[b_uk.side]
-            panels.append((f"g, {b_uk.side} (m)", [("UK", t, b_uk.g, uk),
-                                                    ("direct", b_d.t, b_d.g, dr)]))
-            panels.append((f"μ g, {b_uk.side}", [("UK (N·m)", t, b_uk.complementarity, uk),
-                                                 ("direct", b_d.t, b_d.complementarity, dr)]))
-        paths += _panels(panels, f"{label}: KKT conditions (cf. Figs. {FIGURES['kkt']})",
-                         where / "kkt", formats)
+            panels.append(
+                (f"g, {b_uk.side} (m)", [("UK", t, b_uk.g, uk), ("direct", b_d.t, b_d.g, dr)])
+            )
+            panels.append(
+                (
+                    f"μ g, {b_uk.side}",
+                    [
+                        ("UK (N·m)", t, b_uk.complementarity, uk),
+                        ("direct", b_d.t, b_d.complementarity, dr),
+                    ],
+                )
+            )
+        paths += _panels(
+            panels, f"{label}: KKT conditions (cf. Figs. {FIGURES['kkt']})", where / "kkt", formats
+        )
     return paths
 
 
@@ -284,13 +349,21 @@ SCENARIO = Scenario(
     run,
     figures,
     options=(
-        Option("cases", comma_separated(str), ("smd-gt", "smd-lt", "smd-bi"),
-               "the SMD cases, comma-separated"),
+        Option(
+            "cases",
+            comma_separated(str),
+            ("smd-gt", "smd-lt", "smd-bi"),
+            "the SMD cases, comma-separated",
+        ),
         Option("duration", positive_float, 30.0, "simulated and optimised time (s)"),
         Option("elements", _elements, 150, "collocation elements of the direct optimum"),
         Option("degree", _degree, 3, "LGL degree p of each element (p + 1 nodes)"),
-        Option("refine_tol", non_negative_float, 0.0,
-               "refine the mesh adaptively to this relative error per element (0: do not)"),
+        Option(
+            "refine_tol",
+            non_negative_float,
+            0.0,
+            "refine the mesh adaptively to this relative error per element (0: do not)",
+        ),
     ),
     write_data=write_data,
 )

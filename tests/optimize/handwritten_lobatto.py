@@ -86,7 +86,9 @@ def solve_smd(
     lbx[0] = ubx[0] = x0
     lbx[n_nodes] = ubx[n_nodes] = v0
     solver = ca.nlpsol(
-        "smd", "ipopt", {"x": w, "f": cost, "g": g},
+        "smd",
+        "ipopt",
+        {"x": w, "f": cost, "g": g},
         {"print_time": False, "ipopt.print_level": 0, "ipopt.sb": "yes", "ipopt.tol": 1e-8},
     )
     guess = np.concatenate([np.full(n_nodes, x0), np.full(n_nodes, v0), np.zeros(n_nodes)])
@@ -96,9 +98,7 @@ def solve_smd(
     sol = solver(x0=guess, lbx=lbx, ubx=ubx, lbg=0.0, ubg=0.0)
     solve_s = time.perf_counter() - tic
     out = np.asarray(sol["x"]).reshape(-1)
-    times = np.concatenate(
-        [[0.0]] + [e * h + (tau[1:] + 1.0) * h / 2.0 for e in range(n_elements)]
-    )
+    times = np.concatenate([[0.0]] + [e * h + (tau[1:] + 1.0) * h / 2.0 for e in range(n_elements)])
     return {
         "objective": float(sol["f"]),
         "status": solver.stats()["return_status"],

@@ -93,8 +93,11 @@ def test_an_infeasible_problem_reports_ipopts_status():
     problem = OptimalControlProblem(system, state, 1.0, final={"r": {"p": [2.0, 0.0, 0.0]}})
     with pytest.raises(OptimizationError) as info:
         problem.solve(n_elements=4, max_iter=200)
-    assert info.value.status in ("Infeasible_Problem_Detected", "Restoration_Failed",
-                                 "Local_Infeasibility")
+    assert info.value.status in (
+        "Infeasible_Problem_Detected",
+        "Restoration_Failed",
+        "Local_Infeasibility",
+    )
     assert info.value.status in str(info.value)
     assert info.value.result is not None and not info.value.result.success
 

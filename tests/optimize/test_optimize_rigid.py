@@ -30,7 +30,7 @@ def _slew(inertia, axis, n_elements, degree=3):
     return body, state, gf, problem, problem.solve(Mesh.uniform(0.0, T, n_elements, degree))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _general_slew():
     J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
     return _slew(J, [1.0, 1.0, 1.0], 12, 4)
@@ -67,7 +67,9 @@ def test_resimulating_the_optimal_control_tracks_the_plan_to_1e_4_rad():
     # and the attitude between nodes, from the element's θ interpolant
     t_mid = 0.5 * (result.t[1:] + result.t[:-1])
     traj_mid = driven.simulate(state, (0.0, T), t_eval=t_mid, rtol=1e-11, atol=1e-12)
-    assert _rotation_angles(traj_mid.g_NB[:, 0, :3, :3], result.attitudes_at(t_mid)[:, 0]).max() < 1e-4
+    assert (
+        _rotation_angles(traj_mid.g_NB[:, 0, :3, :3], result.attitudes_at(t_mid)[:, 0]).max() < 1e-4
+    )
 
 
 def test_batched_dynamics_agree_with_the_node_by_node_evaluation():
@@ -77,8 +79,10 @@ def test_batched_dynamics_agree_with_the_node_by_node_evaluation():
     y = result.y + rng.normal(size=result.y.shape)  # translation and rotation both moving
     batch = tr._rhs_batch(result.t, y, result.u, result.R_NB)
     loop = np.array(
-        [tr._rhs_num(float(t), y[i], result.u[i], list(result.R_NB[i]))
-         for i, t in enumerate(result.t)]
+        [
+            tr._rhs_num(float(t), y[i], result.u[i], list(result.R_NB[i]))
+            for i, t in enumerate(result.t)
+        ]
     )
     np.testing.assert_allclose(batch, loop, atol=1e-13)
 

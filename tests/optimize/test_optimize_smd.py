@@ -4,6 +4,7 @@ CasADi transcription, KKT conditions, mesh refinement, equality path constraints
 from __future__ import annotations
 
 import functools
+import itertools
 
 import casadi as ca
 import numpy as np
@@ -15,7 +16,7 @@ from gmuk.optimize import Mesh, OptimalControlProblem
 from gmuk.scenarios import smd
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _bounded(n_elements: int = 150, degree: int = 3):
     system, state = smd.build("smd-bi")
     problem = OptimalControlProblem(system, state, 30.0)
@@ -63,7 +64,7 @@ def test_objective_converges_under_adaptive_mesh_refinement():
     assert steps is not None and len(steps) >= 3
     assert steps[-1].max_error <= 1e-6
     errors = [s.max_error for s in steps]
-    assert all(b < a for a, b in zip(errors, errors[1:], strict=False))
+    assert all(b < a for a, b in itertools.pairwise(errors))
     assert abs(steps[-1].objective - steps[-2].objective) < 1e-5 * steps[-1].objective
     assert abs(steps[0].objective - steps[-1].objective) > 1e-2 * steps[-1].objective
     assert result.mesh.n_elements == steps[-1].n_elements
@@ -78,9 +79,7 @@ def test_the_thesis_single_five_point_element_is_a_mesh_of_one_element():
 
 def test_a_user_cost_replaces_the_gauss_cost():
     system, state = smd.build("smd-bi")
-    problem = OptimalControlProblem(
-        system, state, 30.0, cost=lambda t, q, nu, u: ca.sumsqr(u[0])
-    )
+    problem = OptimalControlProblem(system, state, 30.0, cost=lambda t, q, nu, u: ca.sumsqr(u[0]))
     result = problem.solve(Mesh.uniform(0.0, 30.0, 150, 3))
     _, default = _bounded()
     # ∫|u|² dt = m ∫ uᵀM⁻¹u dt, and the same control is optimal
@@ -122,7 +121,8 @@ def test_the_open_loop_controller_reproduces_the_unconstrained_plan():
         Mesh.uniform(0.0, 5.0, 20, 4)
     )
     driven = gmuk.System(
-        [mass], forces=[gmuk.LinearSpringDamper(smd.STIFFNESS, smd.DAMPING)],
+        [mass],
+        forces=[gmuk.LinearSpringDamper(smd.STIFFNESS, smd.DAMPING)],
         controllers=[result.controller()],
     )
     traj = driven.simulate(state, (0.0, 5.0), t_eval=result.t, rtol=1e-11, atol=1e-12)

@@ -13,8 +13,23 @@ from gmuk.scenarios import OptionError, smd_compare
 
 def test_smd_compare_tabulates_the_direct_optimum_below_the_uk_answer(tmp_path):
     out = tmp_path / "cmp"
-    assert cli.main(["run", "smd-compare", "--cases", "smd-bi,smd-lt", "--duration", "6",
-                     "--elements", "30", "--out", str(out)]) == 0
+    assert (
+        cli.main(
+            [
+                "run",
+                "smd-compare",
+                "--cases",
+                "smd-bi,smd-lt",
+                "--duration",
+                "6",
+                "--elements",
+                "30",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     summary = json.loads((out / "summary.json").read_text())
     for case in ("smd-bi", "smd-lt"):
         s = summary[case]
@@ -26,8 +41,14 @@ def test_smd_compare_tabulates_the_direct_optimum_below_the_uk_answer(tmp_path):
         # the trapezoid on the UK grid and the LGL quadrature measure the same optimum
         assert abs(s["objective_direct"] / s["objective_direct_quadrature"] - 1.0) < 1e-2
     figures = sorted(p.name for p in (out / "smd-bi").glob("*.png"))
-    assert figures == ["control.png", "effort.png", "kkt.png", "multipliers.png",
-                       "position.png", "velocity.png"]
+    assert figures == [
+        "control.png",
+        "effort.png",
+        "kkt.png",
+        "multipliers.png",
+        "position.png",
+        "velocity.png",
+    ]
     with np.load(out / "direct_smd-bi.npz") as data:
         assert data["r_N"].shape == (91, 3)
         assert data["r_N"][:, 0].min() >= 1.0 - 1e-6
