@@ -571,8 +571,8 @@ class _Transcription:
     # layout of the decision vector: vec(Y) (n_y × N), vec(U) (n_u × N), vec(Θ) (n_th × Σp)
     def _build(self) -> None:
         pb, mesh = self.problem, self.mesh
-        N, ny, nu_ = mesh.n_nodes, pb.n_y, pb.n_u
-        self.n_x = (ny + nu_) * N + pb.n_th * self.n_th_cols
+        N, K, ny, nu_, nth = mesh.n_nodes, mesh.n_elements, pb.n_y, pb.n_u, pb.n_th
+        self.n_x = (ny + nu_) * N + nth * self.n_th_cols + nth * K
         # path constraints at nodes 1 … N−1 (the last skipped where the final state fixes
         # the constraint's bodies: it was checked before solving)
         self._path_nodes = [
@@ -588,7 +588,8 @@ class _Transcription:
                 self.mapped = False  # a part needs a numeric time: one expression per node
         if not self.mapped:
             self._build_unrolled()
-        # variable bounds: initial state, given final entries, θ per element
+            self._check_finite()
+        # variable bounds: initial state, given final entries, θ and φ per element (φ₀ = 0)
         lbx = np.full(self.n_x, -np.inf)
         ubx = np.full(self.n_x, np.inf)
         lbx[:ny] = ubx[:ny] = pb.y0
@@ -597,6 +598,8 @@ class _Transcription:
         th0 = (ny + nu_) * N
         lbx[th0:] = -pb.max_element_rotation
         ubx[th0:] = pb.max_element_rotation
+        phi0 = th0 + nth * self.n_th_cols
+        lbx[phi0 : phi0 + nth] = ubx[phi0 : phi0 + nth] = 0.0
         self.lbx, self.ubx = lbx, ubx
 
     def _path_bounds(self, c: Any, kind: str) -> tuple[float, float]:
@@ -626,21 +629,19 @@ class _Transcription:
             L = parts._as_column(pb.cost(t, q, nu, us), "cost", 1)
         return F, values, L
 
-    def _build_mapped(self) -> None:
-        """One CasADi Function per element, with the node times as a symbolic input, mapped
-        over the elements (accumulating the start attitude when there are rigid bodies): the
-        NLP's size no longer sets the cost of building it."""
+    def _element(
+        self, p: int, Rbar: Any, phi: Any, Yk: Any, Uk: Any, THk: Any, tk: Sequence[Any]
+    ) -> tuple[Any, Any, Any, Any, list[Any]]:
+        """One element's expressions: start and end attitudes (3 × 3 n_rigid), the
+        collocation residuals (column), the cost (∫ L over the element) and each
+        constraint's values at nodes 1 … p (columns). ``tk`` numeric or symbolic."""
         import casadi as ca
 
-        pb, mesh = self.problem, self.mesh
-        N, K, p = mesh.n_nodes, mesh.n_elements, mesh.degrees[0]
-        ny, nu_, nth, nr = pb.n_y, pb.n_u, pb.n_th, pb.n_th // 3
-        Yk = ca.SX.sym("y", ny, p + 1)
-        Uk = ca.SX.sym("u", nu_, p + 1)
-        THk = ca.SX.sym("theta", nth, p)
-        tk = ca.SX.sym("t", p + 1)
-        Rin = ca.SX.sym("R", 3, 3 * nr)
-        starts = [Rin[:, 3 * b : 3 * b + 3] for b in range(nr)]
+        pb = self.problem
+        nth, nr = pb.n_th, pb.n_th // 3
+        starts = [
+            Rbar[:, 3 * b : 3 * b + 3] @ _so3.exp_casadi(phi[3 * b : 3 * b + 3]) for b in range(nr)
+        ]
         thetas = [ca.SX.zeros(nth, 1)] + [THk[:, j] for j in range(p)]
         node_R = [starts] + [pb._attitudes(starts, thetas[j]) for j in range(1, p + 1)]
         Fs, Ls = [], []
@@ -654,58 +655,237 @@ class _Transcription:
                     c_vals.append(v)
         _x_nodes, w = lgl_nodes(p)
         h = tk[p] - tk[0]
-        A = ca.DM(0.5 * np.asarray(lgl_integration_matrix(p))[1:].T)
+        A = ca.DM(0.5 * np.asarray(lgl_integration_matrix(p))[1:].T)  # (p+1) × p
         dyn = Yk[:, 1:] - ca.repmat(Yk[:, 0], 1, p) - h * (ca.horzcat(*Fs) @ A)
-        outs = [ca.vec(dyn)]
+        res = [ca.vec(dyn)]
         if nth:
             rates = ca.horzcat(*[pb._theta_rate(thetas[j], Yk[:, j]) for j in range(p + 1)])
-            outs.append(ca.vec(THk - h * (rates @ A)))
-        path = [ca.vertcat(*v) for v in values]
+            res.append(ca.vec(THk - h * (rates @ A)))
         cost = 0.5 * h * (ca.horzcat(*Ls) @ ca.DM(w))
+        R_start = ca.horzcat(*starts) if nr else ca.SX(3, 0)
         R_end = ca.horzcat(*node_R[p]) if nr else ca.SX(3, 0)
-        fn = ca.Function("element", [Rin, Yk, Uk, THk, tk], [R_end, ca.vertcat(*outs), cost, *path])
-        # MX: CasADi differentiates the element Function once, not every node's copy
-        X = ca.MX.sym("x", self.n_x)
-        Y = ca.reshape(X[: ny * N], ny, N)
-        U = ca.reshape(X[ny * N : (ny + nu_) * N], nu_, N)
-        TH = ca.reshape(X[(ny + nu_) * N :], nth, K * p)
+        return R_start, R_end, ca.vertcat(*res), cost, [ca.vertcat(*v) for v in values]
+
+    def _symbols(self, kind: Any) -> tuple[Any, Any, Any, Any, Any, Any, Any]:
+        """x, p and their views: Y (n_y × N), U (n_u × N), Θ (n_th × Σp), Φ (n_th × K),
+        R̄ (3 × 3 n_rigid K)."""
+        import casadi as ca
+
+        pb, mesh = self.problem, self.mesh
+        N, K, ny, nu_, nth = mesh.n_nodes, mesh.n_elements, pb.n_y, pb.n_u, pb.n_th
+        X = kind.sym("x", self.n_x)
+        P = kind.sym("p", 9 * (nth // 3) * K)
+        o1, o2, o3 = ny * N, (ny + nu_) * N, (ny + nu_) * N + nth * self.n_th_cols
+        Y = ca.reshape(X[:o1], ny, N)
+        U = ca.reshape(X[o1:o2], nu_, N)
+        TH = ca.reshape(X[o2:o3], nth, self.n_th_cols)
+        PHI = ca.reshape(X[o3:], nth, K)
+        RBAR = ca.reshape(P, 3, 3 * (nth // 3) * K)
+        return X, P, Y, U, TH, PHI, RBAR
+
+    def _build_mapped(self) -> None:
+        """One CasADi Function per element, with the node times as a symbolic input, mapped
+        over the elements: CasADi differentiates one element, not every node's copy, so the
+        cost of building the NLP hardly grows with the mesh."""
+        import casadi as ca
+
+        pb, mesh = self.problem, self.mesh
+        K, p = mesh.n_elements, mesh.degrees[0]
+        ny, nu_, nth, nr = pb.n_y, pb.n_u, pb.n_th, pb.n_th // 3
+        sym = [
+            ca.SX.sym("Rbar", 3, 3 * nr),
+            ca.SX.sym("phi", nth),
+            ca.SX.sym("y", ny, p + 1),
+            ca.SX.sym("u", nu_, p + 1),
+            ca.SX.sym("theta", nth, p),
+            ca.SX.sym("t", p + 1),
+        ]
+        R_start, R_end, res, cost, path = self._element(
+            p, *sym[:5], [sym[5][j] for j in range(p + 1)]
+        )
+        fn = ca.Function("element", sym, [R_start, R_end, res, cost, *path])
+        # float() or math.* on a symbol gives NaN silently (CasADi's SX.__float__): a part
+        # that needs a numeric time shows it here, at the start, and goes node by node
+        x0, p0 = self._sample_point()
+        Ys = np.repeat(self.problem.y0[:, None], p + 1, axis=1)
+        sample = fn(
+            p0[: 9 * nr].reshape(3, -1, order="F"),
+            np.zeros(nth),
+            Ys,
+            np.zeros((nu_, p + 1)),
+            np.zeros((nth, p)),
+            self.times[: p + 1],
+        )
+        if not all(np.all(np.isfinite(np.asarray(v))) for v in sample):
+            raise DefinitionError("a part is not finite with a symbolic time")
+        X, P, Y, U, TH, PHI, RBAR = self._symbols(ca.MX)
         idx = [k * p + j for k in range(K) for j in range(p + 1)]
         T = ca.DM(np.asarray(self.times)[idx].reshape(K, p + 1).T)
-        if nr:
-            R0 = ca.DM(np.hstack(pb.R0))
-            res = fn.mapaccum("elements", K)(R0, Y[:, idx], U[:, idx], TH, T)
-            R_last = res[0][:, (K - 1) * 3 * nr :]
-        else:
-            res = fn.map(K)(ca.DM(3, 0), Y[:, idx], U[:, idx], TH, T)
-            R_last = None
-        g_blocks = [ca.vec(res[1])]
-        n_dyn = g_blocks[0].shape[0]
-        lbg, ubg = [0.0] * n_dyn, [0.0] * n_dyn
+        out = fn.map(K)(RBAR, PHI, Y[:, idx], U[:, idx], TH, T)
+        self._assemble(
+            X, P, U, out[0], out[1], ca.vec(out[2]), out[3], [ca.vec(o) for o in out[4:]]
+        )
+
+    def _build_unrolled(self) -> None:
+        """One expression per element, each part called with the nodes' numeric times."""
+        import casadi as ca
+
+        pb, mesh = self.problem, self.mesh
+        nr = pb.n_th // 3
+        X, P, Y, U, TH, PHI, RBAR = self._symbols(ca.SX)
+        outs = []
+        col = 0
+        for k, p in enumerate(mesh.degrees):
+            i0 = mesh.first_node(k)
+            outs.append(
+                self._element(
+                    p,
+                    RBAR[:, 3 * nr * k : 3 * nr * (k + 1)],
+                    PHI[:, k],
+                    Y[:, i0 : i0 + p + 1],
+                    U[:, i0 : i0 + p + 1],
+                    TH[:, col : col + p],
+                    [float(t) for t in self.times[i0 : i0 + p + 1]],
+                )
+            )
+            col += p
+        self._assemble(
+            X,
+            P,
+            U,
+            ca.horzcat(*[o[0] for o in outs]),
+            ca.horzcat(*[o[1] for o in outs]),
+            ca.vertcat(*[o[2] for o in outs]),
+            ca.horzcat(*[o[3] for o in outs]),
+            [ca.vertcat(*[o[4][c] for o in outs]) for c in range(len(pb._constraints))],
+        )
+
+    def _assemble(
+        self,
+        X: Any,
+        P: Any,
+        U: Any,
+        R_start: Any,
+        R_end: Any,
+        dyn: Any,
+        costs: Any,
+        path: list[Any],
+    ) -> None:
+        """The NLP from the elements' outputs: collocation residuals, attitude continuity
+        between elements, path constraints (element-major: nodes 1 … N−1 in order), final
+        attitudes, and the cost."""
+        import casadi as ca
+
+        pb, K = self.problem, self.mesh.n_elements
+        nr = pb.n_th // 3
+        g_blocks = [dyn]
+        if nr and K > 1:
+            Ra, Rb = ca.SX.sym("Ra", 3, 3 * nr), ca.SX.sym("Rb", 3, 3 * nr)
+            rows = [
+                _skew_vee(Ra[:, 3 * b : 3 * b + 3].T @ Rb[:, 3 * b : 3 * b + 3]) for b in range(nr)
+            ]
+            cont = ca.Function("continuity", [Ra, Rb], [ca.vertcat(*rows)])
+            g_blocks.append(
+                ca.vec(cont.map(K - 1)(R_start[:, 3 * nr :], R_end[:, : 3 * nr * (K - 1)]))
+            )
+        n_eq = sum(b.shape[0] for b in g_blocks)
+        lbg, ubg = [0.0] * n_eq, [0.0] * n_eq
         self.path_rows: list[tuple[Any, str, np.ndarray, int, int]] = []
-        row = n_dyn
-        for (c, kind, _), nodes, out in zip(
-            pb._constraints, self._path_nodes, res[3:], strict=True
+        row = n_eq
+        for (c, kind, _), nodes, values in zip(
+            pb._constraints, self._path_nodes, path, strict=True
         ):
-            s = out.shape[0] // p
-            block = ca.vec(out)[: s * nodes.size]  # nodes 1 … N−1 in order, s rows each
+            if nodes.size == 0:
+                continue
+            s = values.shape[0] // (self.mesh.n_nodes - 1)
+            block = values[: s * nodes.size]
             lo, hi = self._path_bounds(c, kind)
             lbg += [lo] * block.shape[0]
             ubg += [hi] * block.shape[0]
             g_blocks.append(block)
             self.path_rows.append((c, kind, nodes, row, s))
             row += block.shape[0]
-        att = self._final_attitude_rows(
-            [R_last[:, 3 * b : 3 * b + 3] for b in range(nr)] if R_last is not None else []
-        )
+        R_last = R_end[:, R_end.shape[1] - 3 * nr :]
+        att = self._final_attitude_rows([R_last[:, 3 * b : 3 * b + 3] for b in range(nr)])
         lbg += [0.0] * att.shape[0]
         ubg += [0.0] * att.shape[0]
         self.x: Any = X
+        self.p: Any = P
         self.g = ca.vertcat(*g_blocks, att)
-        if pb.cost is None:  # quadratic in U: one MX expression, outside the map
+        if pb.cost is None:  # quadratic in U: one expression, outside the elements
             self.f = ca.sum2(ca.sum1(U * (_dm(pb._M_inv) @ U)) * _dm(self.W).T)
         else:
-            self.f = ca.sum2(res[2])
+            self.f = ca.sum2(costs)
         self.lbg, self.ubg = np.array(lbg), np.array(ubg)
+
+    def _sample_point(self) -> tuple[FloatArray, FloatArray]:
+        """x with the initial state at every node and zero controls and charts, and p with
+        the initial attitudes as every element's reference."""
+        pb, mesh = self.problem, self.mesh
+        x = np.zeros(self.n_x)
+        x[: pb.n_y * mesh.n_nodes] = np.tile(pb.y0, mesh.n_nodes)
+        Rbar = np.tile(np.array(pb.R0).reshape(1, -1, 3, 3), (mesh.n_elements, 1, 1, 1))
+        p = np.transpose(Rbar, (2, 0, 1, 3)).reshape(3, -1).reshape(-1, order="F")
+        return x, p
+
+    def _check_finite(self) -> None:
+        """Refuse an NLP that is not finite at the sample point, naming the part that
+        returns NaN there (a numeric method called with CasADi symbols)."""
+        import casadi as ca
+
+        x, p = self._sample_point()
+        fg = ca.Function("fg", [self.x, self.p], [self.f, self.g])
+        if all(np.all(np.isfinite(np.asarray(v))) for v in fg(x, p)):
+            return
+        pb = self.problem
+        y = ca.SX.sym("y", pb.n_y)
+        Rs = [ca.SX.sym("R", 3, 3) for _ in pb.R0]
+        args = [y, *Rs]
+        values = [np.asarray(pb.y0), *[np.asarray(R) for R in pb.R0]]
+        q, nu = pb._casadi_qv(pb._plans, y, Rs)
+        index = {p_.body.name: i for i, p_ in enumerate(pb._plans)}
+        t = float(self.times[0])
+        suspects: list[tuple[str, Any]] = []
+        for f, plans in pb._forces:
+            ids = [index[p_.body.name] for p_ in plans]
+            suspects.append(
+                (
+                    f"force model {f.name!r} ({type(f).__name__})",
+                    lambda f=f, ids=ids, plans=plans: ca.vertcat(
+                        *parts.force_terms(
+                            f,
+                            t,
+                            [q[i] for i in ids],
+                            [nu[i] for i in ids],
+                            [p_.body for p_ in plans],
+                        )
+                    ),
+                )
+            )
+        for c, kind, plans in pb._constraints:
+            ids = [index[p_.body.name] for p_ in plans]
+            fn = parts.inequality_value if kind == "inequality" else parts.equality_residual
+            suspects.append(
+                (
+                    f"constraint {c.name!r} ({type(c).__name__})",
+                    lambda c=c, fn=fn, ids=ids: fn(
+                        c, tuple(q[i] for i in ids), tuple(nu[i] for i in ids), t
+                    ),
+                )
+            )
+        for who, build in suspects:
+            value = np.asarray(ca.Function("part", args, [build()])(*values))
+            if not np.all(np.isfinite(value)):
+                raise DefinitionError(
+                    f"{who} returns NaN or inf at the initial state when evaluated with "
+                    "CasADi symbols: does its CasADi form call float(), math.* or numpy on a "
+                    "symbol (CasADi turns those into NaN silently)? Write it with casadi "
+                    "operations"
+                )
+        raise DefinitionError(
+            "the transcribed problem is not finite at the initial state (NaN or inf in the "
+            "dynamics, constraints or cost there)"
+        )
 
     def _final_attitude_rows(self, R_final: Sequence[Any]) -> Any:
         """vee(skew(R_fᵀ R(tf))) = 0 for every rigid body with a given final attitude."""
@@ -715,79 +895,15 @@ class _Transcription:
         rows = []
         for p in pb._plans:
             if p.rigid and p.body.name in pb._final_R:
-                E = ca.DM(pb._final_R[p.body.name]).T @ R_final[p.th // 3]
-                rows.append(
-                    0.5 * ca.vertcat(E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1])
-                )
+                rows.append(_skew_vee(ca.DM(pb._final_R[p.body.name]).T @ R_final[p.th // 3]))
         return ca.vertcat(*rows) if rows else ca.DM(0, 1)
 
-    def _build_unrolled(self) -> None:
-        """One expression per node, each part called with the node's numeric time."""
-        import casadi as ca
-
-        pb, mesh = self.problem, self.mesh
-        N, ny, nu_, nth = mesh.n_nodes, pb.n_y, pb.n_u, pb.n_th
-        Y = ca.SX.sym("y", ny, N)
-        U = ca.SX.sym("u", nu_, N)
-        TH = ca.SX.sym("theta", nth, self.n_th_cols)
-        self.x = ca.vertcat(ca.vec(Y), ca.vec(U), ca.vec(TH))
-        ycols = [Y[:, i] for i in range(N)]
-        node_R: list[list[Any]] = [[] for _ in range(N)]
-        R_start: list[Any] = [ca.DM(R) for R in pb.R0]
-        node_R[0] = R_start
-        col = 0
-        theta_cols: list[list[Any]] = []
-        for k, p in enumerate(mesh.degrees):
-            i0 = mesh.first_node(k)
-            ths = [ca.DM.zeros(nth, 1)] + [TH[:, col + j] for j in range(p)]
-            theta_cols.append(ths)
-            col += p
-            for j in range(1, p + 1):
-                node_R[i0 + j] = pb._attitudes(R_start, ths[j])
-            R_start = node_R[i0 + p]
-        terms = [
-            self._node_terms(float(self.times[i]), ycols[i], U[:, i], node_R[i]) for i in range(N)
-        ]
-        Fm = ca.horzcat(*[tm[0] for tm in terms])
-        g_blocks = []
-        for k, p in enumerate(mesh.degrees):
-            i0 = mesh.first_node(k)
-            h = mesh.breaks[k + 1] - mesh.breaks[k]
-            A = ca.DM(0.5 * h * np.asarray(lgl_integration_matrix(p))[1:].T)  # (p+1) × p
-            dy = Y[:, i0 + 1 : i0 + p + 1] - ca.repmat(Y[:, i0], 1, p) - Fm[:, i0 : i0 + p + 1] @ A
-            g_blocks.append(ca.vec(dy))
-            if nth:
-                ths = theta_cols[k]
-                rates = ca.horzcat(*[pb._theta_rate(ths[j], ycols[i0 + j]) for j in range(p + 1)])
-                g_blocks.append(ca.vec(ca.horzcat(*ths[1:]) - rates @ A))
-        n_dyn = sum(b.shape[0] for b in g_blocks)
-        lbg, ubg = [0.0] * n_dyn, [0.0] * n_dyn
-        self.path_rows = []
-        row = n_dyn
-        for ci, ((c, kind, _), nodes) in enumerate(
-            zip(pb._constraints, self._path_nodes, strict=True)
-        ):
-            if nodes.size == 0:
-                continue
-            block = ca.vertcat(*[terms[i][1][ci] for i in nodes])
-            s = block.shape[0] // nodes.size
-            lo, hi = self._path_bounds(c, kind)
-            lbg += [lo] * block.shape[0]
-            ubg += [hi] * block.shape[0]
-            g_blocks.append(block)
-            self.path_rows.append((c, kind, nodes, row, s))
-            row += block.shape[0]
-        att = self._final_attitude_rows(node_R[N - 1])
-        lbg += [0.0] * att.shape[0]
-        ubg += [0.0] * att.shape[0]
-        self.g = ca.vertcat(*g_blocks, att)
-        self.lbg, self.ubg = np.array(lbg), np.array(ubg)
-        self.f = ca.vertcat(*[tm[2] for tm in terms]).T @ ca.DM(self.W)
-
     # ------------------------------------------------------------------ guess
-    def initial_guess(self, guess: OptimalControlResult | None) -> FloatArray:
+    def initial_guess(self, guess: OptimalControlResult | None) -> tuple[FloatArray, FloatArray]:
+        """The starting point x₀ and the reference attitudes R̄ (the parameters p)."""
         pb, mesh = self.problem, self.mesh
         N, t = mesh.n_nodes, self.times
+        nr = pb.n_th // 3
         s = (t - pb.t0) / (pb.tf - pb.t0)
         if guess is not None:
             Yg = guess.states_at(t, pb)
@@ -810,20 +926,33 @@ class _Transcription:
                     r in pb._final_y for r in range(p.y + 3, p.y + 6)
                 ):
                     Yg[:, p.y + 3 : p.y + 6] = phi / (pb.tf - pb.t0)
+        if nr:
+            Rg[0] = np.array(pb.R0)  # the start is given
         TH = np.zeros((pb.n_th, self.n_th_cols))
+        Rbar = np.zeros((mesh.n_elements, nr, 3, 3))
         col = 0
         for k, deg in enumerate(mesh.degrees):
             i0 = mesh.first_node(k)
+            for b in range(nr):
+                Rbar[k, b] = _orthonormal(Rg[i0, b])
             for j in range(1, deg + 1):
-                for b in range(pb.n_th // 3):
-                    d = so3.log(_orthonormal(Rg[i0, b].T @ Rg[i0 + j, b]))
+                for b in range(nr):
+                    d = so3.log(_orthonormal(Rbar[k, b].T @ Rg[i0 + j, b]))
                     TH[3 * b : 3 * b + 3, col + j - 1] = np.clip(
                         d, -pb.max_element_rotation, pb.max_element_rotation
                     )
             col += deg
-        return np.concatenate(
-            [Yg.T.reshape(-1, order="F"), Ug.T.reshape(-1, order="F"), TH.reshape(-1, order="F")]
+        x0 = np.concatenate(
+            [
+                Yg.reshape(-1),
+                Ug.reshape(-1),
+                TH.reshape(-1, order="F"),
+                np.zeros(pb.n_th * mesh.n_elements),
+            ]
         )
+        # p = vec(R̄) with R̄ (3, 3 n_rigid K): element k, body b in columns 3(n_r k + b) …
+        p = np.transpose(Rbar, (2, 0, 1, 3)).reshape(3, -1).reshape(-1, order="F")
+        return x0, p
 
     # ------------------------------------------------------------------ solve
     def solve(
@@ -861,16 +990,16 @@ class _Transcription:
             opts["ipopt.file_print_level"] = 5
         for k, v in (ipopt_options or {}).items():
             opts[k if k.startswith("ipopt.") else f"ipopt.{k}"] = v
-        nlp = {"x": self.x, "f": self.f, "g": self.g}
+        nlp = {"x": self.x, "p": self.p, "f": self.f, "g": self.g}
         try:
             solver = ca.nlpsol("gmuk", "ipopt", nlp, opts)
         except RuntimeError as exc:
             raise DefinitionError(f"CasADi refused the IPOPT options: {exc}") from None
-        x0 = self.initial_guess(guess)
+        x0, pbar = self.initial_guess(guess)
         x0 = np.clip(x0, self.lbx, self.ubx)
         setup = time.perf_counter() - tic
         tic = time.perf_counter()
-        out = solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        out = solver(x0=x0, p=pbar, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         solve_s = time.perf_counter() - tic
         stats = solver.stats()
         text = None
@@ -893,39 +1022,45 @@ class _Transcription:
             "total_s": transcription_s + setup + solve_s,
         }
         return self._result(
-            x, lam_g, lam_x, gval, float(out["f"]), stats, history, text, timings, viol
+            x, pbar, lam_g, lam_x, gval, float(out["f"]), stats, history, text, timings, viol
         )
 
-    def _unpack(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        pb, N = self.problem, self.mesh.n_nodes
-        ny, nu_ = pb.n_y, pb.n_u
-        Y = x[: ny * N].reshape(N, ny)
-        U = x[ny * N : (ny + nu_) * N].reshape(N, nu_)
-        TH = x[(ny + nu_) * N :].reshape(self.n_th_cols, pb.n_th)
-        return Y, U, TH
+    def _unpack(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        pb, N, K = self.problem, self.mesh.n_nodes, self.mesh.n_elements
+        ny, nu_, nth = pb.n_y, pb.n_u, pb.n_th
+        o1, o2, o3 = ny * N, (ny + nu_) * N, (ny + nu_) * N + nth * self.n_th_cols
+        Y = x[:o1].reshape(N, ny)
+        U = x[o1:o2].reshape(N, nu_)
+        TH = x[o2:o3].reshape(self.n_th_cols, nth)
+        PHI = x[o3:].reshape(K, nth)
+        return Y, U, TH, PHI
 
-    def _attitude_chain(self, TH: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Node attitudes (N, n_rigid, 3, 3) and element-start attitudes, by exponentials."""
+    def _attitudes_numeric(
+        self, TH: FloatArray, PHI: FloatArray, pbar: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """Node attitudes (N, n_rigid, 3, 3) and element-start attitudes (K, n_rigid, 3, 3),
+        ``R̄_k exp(φ_k) exp(θ)``: products of exponentials. A node shared by two elements
+        takes the end of the earlier one (the start of the next equals it to the solver's
+        tolerance on the continuity rows)."""
         pb, mesh = self.problem, self.mesh
-        nr = pb.n_th // 3
+        nr, K = pb.n_th // 3, mesh.n_elements
+        Rbar = pbar.reshape(3, -1, order="F").reshape(3, K, nr, 3).transpose(1, 2, 0, 3)
+        starts = Rbar @ so3.exp(PHI.reshape(K, nr, 3))
         R = np.zeros((mesh.n_nodes, nr, 3, 3))
-        starts = np.zeros((mesh.n_elements, nr, 3, 3))
-        Rk = np.array(pb.R0).reshape(nr, 3, 3)
         if nr:
-            R[0] = Rk
+            R[0] = starts[0]
         col = 0
         for k, p in enumerate(mesh.degrees):
-            starts[k] = Rk
             i0 = mesh.first_node(k)
             th = TH[col : col + p].reshape(p, nr, 3)
-            R[i0 + 1 : i0 + p + 1] = Rk[None] @ so3.exp(th)
-            Rk = R[i0 + p]
+            R[i0 + 1 : i0 + p + 1] = starts[k][None] @ so3.exp(th)
             col += p
         return R, starts
 
     def _result(
         self,
         x: FloatArray,
+        pbar: FloatArray,
         lam_g: FloatArray,
         lam_x: FloatArray,
         gval: FloatArray,
@@ -937,8 +1072,8 @@ class _Transcription:
         violation: float,
     ) -> OptimalControlResult:
         pb, mesh = self.problem, self.mesh
-        Y, U, TH = self._unpack(x)
-        R, starts = self._attitude_chain(TH)
+        Y, U, TH, PHI = self._unpack(x)
+        R, starts = self._attitudes_numeric(TH, PHI, pbar)
         paths = {}
         for c, kind, nodes, r0, m in self.path_rows:
             n = nodes.size
@@ -980,7 +1115,7 @@ class _Transcription:
                 "n_variables": int(x.size),
                 "n_constraints": int(gval.size),
             },
-            _kkt=_KKTEvaluator(self, x, lam_g, lam_x),
+            _kkt=_KKTEvaluator(self, x, pbar, lam_g, lam_x),
         )
 
     # ------------------------------------------------------------------ error estimate
@@ -1087,19 +1222,27 @@ class _KKTEvaluator:
     the Lagrangian only then)."""
 
     def __init__(
-        self, tr: _Transcription, x: FloatArray, lam_g: FloatArray, lam_x: FloatArray
+        self,
+        tr: _Transcription,
+        x: FloatArray,
+        p: FloatArray,
+        lam_g: FloatArray,
+        lam_x: FloatArray,
     ) -> None:
-        self.tr, self.x, self.lam_g, self.lam_x = tr, x, lam_g, lam_x
+        self.tr, self.x, self.p, self.lam_g, self.lam_x = tr, x, p, lam_g, lam_x
 
     def __call__(self) -> dict[str, float]:
         import casadi as ca
 
         tr = self.tr
         lam = type(tr.x).sym("lam", tr.g.shape[0])
-        grad = ca.Function("grad_L", [tr.x, lam], [ca.gradient(tr.f + ca.dot(lam, tr.g), tr.x)])
-        gL = np.asarray(grad(self.x, self.lam_g)).reshape(-1) + self.lam_x
-        grad_f = np.asarray(ca.Function("grad_f", [tr.x], [ca.gradient(tr.f, tr.x)])(self.x))
-        gval = np.asarray(ca.Function("g", [tr.x], [tr.g])(self.x)).reshape(-1)
+        grad = ca.Function(
+            "grad_L", [tr.x, tr.p, lam], [ca.gradient(tr.f + ca.dot(lam, tr.g), tr.x)]
+        )
+        gL = np.asarray(grad(self.x, self.p, self.lam_g)).reshape(-1) + self.lam_x
+        grad_f = ca.Function("grad_f", [tr.x, tr.p], [ca.gradient(tr.f, tr.x)])
+        grad_f_val = np.asarray(grad_f(self.x, self.p))
+        gval = np.asarray(ca.Function("g", [tr.x, tr.p], [tr.g])(self.x, self.p)).reshape(-1)
         primal = np.maximum(np.maximum(tr.lbg - gval, gval - tr.ubg), 0.0)
         primal_x = np.maximum(np.maximum(tr.lbx - self.x, self.x - tr.ubx), 0.0)
         # complementarity of the inequality rows: λ times the distance to the bound it pushes
@@ -1121,12 +1264,20 @@ class _KKTEvaluator:
         return {
             "stationarity": float(np.abs(gL).max(initial=0.0)),
             "stationarity_relative": float(
-                np.abs(gL).max(initial=0.0) / max(1.0, float(np.abs(grad_f).max(initial=0.0)))
+                np.abs(gL).max(initial=0.0) / max(1.0, float(np.abs(grad_f_val).max(initial=0.0)))
             ),
             "primal_violation": float(max(primal.max(initial=0.0), primal_x.max(initial=0.0))),
             "complementarity": comp,
             "dual_violation": dual,
         }
+
+
+def _skew_vee(E: Any) -> Any:
+    """vee of the skew part of a 3 × 3 CasADi matrix: sin(angle) times the axis of a
+    rotation E, zero iff E = I (or a half turn)."""
+    import casadi as ca
+
+    return 0.5 * ca.vertcat(E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1])
 
 
 def _dm(a: FloatArray) -> Any:

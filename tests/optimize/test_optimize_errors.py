@@ -160,3 +160,18 @@ def test_import_gmuk_does_not_import_casadi():
     code = "import sys, gmuk; print('casadi' in sys.modules, 'gmuk.optimize' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
+
+
+class FloatValue(gmuk.InequalityConstraint):
+    """h = x through float(): fine with numbers, NaN with CasADi symbols."""
+
+    def value(self, q, nu, t):
+        return float(q[0][0])
+
+
+def test_a_part_that_turns_symbols_into_nan_is_named():
+    mass = gmuk.PointMass("p", 1.0)
+    system = gmuk.System([mass], [FloatValue([mass], lower=0.0, name="x-float")])
+    state = system.state(r={"p": [1.0, 0.0, 0.0]}, v={"p": [0.0, 0.0, 0.0]})
+    with pytest.raises(DefinitionError, match=r"constraint 'x-float' \(FloatValue\).*float\(\)"):
+        OptimalControlProblem(system, state, 1.0).solve(n_elements=3)

@@ -98,3 +98,36 @@ def test_series_exponential_and_chart_kinematics():
         h = 1e-6
         dR = (so3.exp(th + h * rate) - so3.exp(th - h * rate)) / (2 * h)
         np.testing.assert_allclose(dR, so3.exp(th) @ so3.hat(omega), atol=1e-8)
+
+
+def test_the_unrolled_transcription_gives_the_mapped_optimum(monkeypatch):
+    """The per-node transcription (parts called with numeric times) and the mapped one are
+    the same NLP."""
+    _, _, _, problem, mapped = _general_slew()
+
+    def refuse(self):
+        raise gmuk.errors.DefinitionError("forced")
+
+    monkeypatch.setattr(_Transcription, "_build_mapped", refuse)
+    unrolled = problem.solve(mapped.mesh)
+    assert abs(unrolled.objective - mapped.objective) < 1e-9 * mapped.objective
+    np.testing.assert_allclose(unrolled.R_NB, mapped.R_NB, atol=1e-8)
+
+
+def test_a_slew_refines_from_its_previous_solution():
+    J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
+    body = gmuk.RigidBody("sat", 100.0, J)
+    system = gmuk.System([body])
+    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
+    gf = np.eye(4)
+    gf[:3, :3] = so3.exp([1.5, 1.5, 0.0])  # 122°: more than one element's chart bound
+    final = {"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
+    problem = OptimalControlProblem(system, state, T, final=final)
+    result = problem.solve_adaptive(Mesh.uniform(0.0, T, 2, 3), tol=1e-7)
+    steps = result.refinement
+    assert steps[-1].max_error <= 1e-7 and len(steps) >= 2
+    fine = problem.solve(Mesh.uniform(0.0, T, 24, 5))
+    assert abs(result.objective - fine.objective) < 1e-6 * fine.objective
+    assert _rotation_angles(result.R_NB[-1, 0], gf[:3, :3]) < 1e-9
+    R = result.R_NB[:, 0]
+    assert np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max() < 1e-10

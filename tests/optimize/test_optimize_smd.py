@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import math
 
 import casadi as ca
 import numpy as np
@@ -129,3 +130,41 @@ def test_the_open_loop_controller_reproduces_the_unconstrained_plan():
     np.testing.assert_allclose(traj.r_N[:, 0], result.r_N[:, 0], atol=1e-6)
     with pytest.raises(gmuk.errors.DefinitionError, match="times must lie"):
         result.control(5.5)
+
+
+class Push(gmuk.ForceModel):
+    """A time-varying push written with math.sin: it needs a numeric time."""
+
+    def force(self, t, r_N, v_N, body):
+        return np.array([math.sin(t), 0.0, 0.0])
+
+    def casadi_force(self, t, r_N, v_N, body):
+        return ca.DM([math.sin(t), 0.0, 0.0])
+
+
+def test_parts_that_need_a_numeric_time_fall_back_to_one_expression_per_node():
+    mass = gmuk.PointMass("mass", smd.MASS)
+    system = gmuk.System([mass], forces=[Push()])
+    state = system.state(r={"mass": [0.0, 0.0, 0.0]}, v={"mass": [0.0, 0.0, 0.0]})
+    final = {"r": {"mass": [0.0, 0.0, 0.0]}, "v": {"mass": [0.0, 0.0, 0.0]}}
+    result = OptimalControlProblem(system, state, 2 * math.pi, final=final).solve(
+        Mesh.uniform(0.0, 2 * math.pi, 12, 5)
+    )
+    # holding the mass still against sin t costs ∫ sin²t / m dt = π/m; moving it may cost less
+    assert 0.0 < result.objective < math.pi / smd.MASS
+    assert result.success
+
+
+def test_mixed_degrees_and_the_mapped_mesh_agree_where_they_coincide(monkeypatch):
+    from gmuk.optimize.problem import _Transcription
+
+    problem, mapped = _bounded()
+
+    def refuse(self):
+        raise gmuk.errors.DefinitionError("forced")
+
+    monkeypatch.setattr(_Transcription, "_build_mapped", refuse)
+    unrolled = problem.solve(mapped.mesh)
+    assert abs(unrolled.objective - mapped.objective) < 1e-9 * mapped.objective
+    mixed = problem.solve(Mesh(np.linspace(0.0, 30.0, 151), [3, 4] * 75))
+    assert mixed.success and abs(mixed.objective / mapped.objective - 1.0) < 1e-2
