@@ -31,10 +31,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "optimize"))
 
-from handwritten_lobatto import solve_smd  # noqa: E402
+from handwritten_lobatto import solve_smd
 
-from gmuk.optimize import Mesh, OptimalControlProblem  # noqa: E402
-from gmuk.scenarios import smd  # noqa: E402
+from gmuk.optimize import Mesh, OptimalControlProblem
+from gmuk.scenarios import smd
 
 
 def gmuk_once(n_elements: int, degree: int) -> dict[str, float]:

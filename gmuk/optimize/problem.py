@@ -701,12 +701,12 @@ class _Transcription:
             ca.SX.sym("t", p + 1),
         ]
         R_start, R_end, res, cost, path = self._element(
-            p, *sym[:5], [sym[5][j] for j in range(p + 1)]
+            p, sym[0], sym[1], sym[2], sym[3], sym[4], [sym[5][j] for j in range(p + 1)]
         )
         fn = ca.Function("element", sym, [R_start, R_end, res, cost, *path])
         # float() or math.* on a symbol gives NaN silently (CasADi's SX.__float__): a part
         # that needs a numeric time shows it here, at the start, and goes node by node
-        x0, p0 = self._sample_point()
+        _x0, p0 = self._sample_point()
         Ys = np.repeat(self.problem.y0[:, None], p + 1, axis=1)
         sample = fn(
             p0[: 9 * nr].reshape(3, -1, order="F"),
@@ -951,8 +951,8 @@ class _Transcription:
             ]
         )
         # p = vec(R̄) with R̄ (3, 3 n_rigid K): element k, body b in columns 3(n_r k + b) …
-        p = np.transpose(Rbar, (2, 0, 1, 3)).reshape(3, -1).reshape(-1, order="F")
-        return x0, p
+        params = np.transpose(Rbar, (2, 0, 1, 3)).reshape(3, -1).reshape(-1, order="F")
+        return x0, params
 
     # ------------------------------------------------------------------ solve
     def solve(
