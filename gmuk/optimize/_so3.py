@@ -8,7 +8,7 @@ start, so that ``Ṙ = R ω^`` gives ``θ̇ = J_r(θ)⁻¹ ω`` with the inverse
 and Rodrigues' ``exp(θ^) = I + a θ^ + b θ^²``, a = sin θ / θ, b = (1 − cos θ)/θ².
 The coefficients are evaluated as power series in s = θ·θ (entire for a and b; radius
 (2π)² for c): smooth at θ = 0, where the closed forms are 0/0, so CasADi differentiates them
-without a branch. The series are summed to rounding error for |θ| ≤ 2.7 rad, which the
+without a branch. The series are summed to rounding error for ‖θ‖ ≤ 2.7 rad, which the
 transcription guarantees by bounding each component of θ (1.5 rad by default).
 
 References
@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from scipy.special import zeta
 
-#: Largest |θ| (rad) for which the series below are summed to rounding error.
+#: Largest ‖θ‖ (rad) for which the series below are summed to rounding error.
 SERIES_RADIUS = 2.7
 
 _N_AB = 16
@@ -51,7 +51,7 @@ def coefficients(s: Any) -> tuple[Any, Any, Any]:
 
 
 def exp_numeric(theta: np.ndarray) -> np.ndarray:
-    """exp(θ^) (3, 3) for |θ| ≤ SERIES_RADIUS by the series (as the transcription)."""
+    """exp(θ^) (3, 3) for ‖θ‖ ≤ SERIES_RADIUS by the series (as the transcription)."""
     th = np.asarray(theta, dtype=float)
     a, b, _ = coefficients(float(th @ th))
     W = _hat(th)

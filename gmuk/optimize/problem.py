@@ -1,7 +1,7 @@
 """Direct Lobatto (LGL) collocation of a gmuk System: transcription, solve, mesh refinement.
 
 The continuous problem, for the physical bodies of a :class:`gmuk.System` (point masses and
-rigid bodies; the slack coordinates of its inequality constraints are not used), is
+rigid bodies; the slack coordinates of its inequality constraints are not used), is::
 
     minimise  J = ∫ uᵀ M⁻¹ u dt   (or ∫ L(t, q, ν, u) dt)
     subject to  M ν̇ = Q(t, q, ν) + u            (rigid bodies: + ad*_V 𝕀V, Eq. 10b)
@@ -19,7 +19,7 @@ Transcription
 Every element ``[t_k, t_{k+1}]`` of the :class:`~gmuk.optimize.Mesh` carries the p_k + 1 LGL
 nodes; states and controls are unknowns at every distinct node (boundary nodes shared, so
 states and controls are continuous there). The dynamics ``ẏ = F(t, y, u)`` are imposed in
-integral form (Lobatto IIIA collocation, order 2p at the element ends):
+integral form (Lobatto IIIA collocation, order 2p at the element ends)::
 
     y_j = y_0 + (h/2) Σ_l A_jl F_l,   j = 1 … p,
 
@@ -28,12 +28,17 @@ cost is the LGL quadrature ``Σ_i W_i uᵢᵀ M⁻¹ uᵢ``; path constraints ar
 after the first (the initial state is fixed and checked before solving).
 
 A rigid body's attitude is kept on SO(3) by local exponential coordinates about each
-element's start: ``R(t) = R_k exp(θ(t)^)`` with ``θ(t_k) = 0`` and ``θ̇ = J_r(θ)⁻¹ ω``;
-``R_{k+1} = R_k exp(θ_p)`` chains the elements. The unknowns are θ (3 per node after the
-first of each element), ω, v_B and r_N; ``ṙ_N = R v_B``. Every attitude gmuk reports is a
-product of exponentials, so it is a rotation to rounding error whatever the solver's
-iterates; no unit-norm or orthogonality constraint is needed, and θ stays small (bounded
-per element), away from the chart's singularity at |θ| = 2π. Translation is in inertial
+element's start: ``R(t) = R_k exp(θ(t)^)`` with ``θ(t_k) = 0`` and ``θ̇ = J_r(θ)⁻¹ ω``, and
+the start itself ``R_k = R̄_k exp(φ_k^)`` about a constant reference R̄_k taken from the
+starting guess (an NLP parameter; φ_0 = 0). Three rows per element boundary,
+``vee(skew(R_{k+1}ᵀ R_k exp(θ_p^))) = 0``, join the elements; the same form fixes a final
+attitude. The unknowns are θ (3 per node after the first of each element), φ (3 per
+element), ω, v_B and r_N; ``ṙ_N = R v_B``. Every attitude gmuk reports is a product of
+exponentials, so it is a rotation to rounding error whatever the solver's iterates; no
+unit-norm or orthogonality constraint is needed, and θ and φ stay small (bounded per
+element), away from the chart's singularity at ‖θ‖ = 2π. Unknown start attitudes, rather
+than the chain ``R_{k+1} = R_k exp(θ_p)``, keep the NLP sparse: with the chain every element
+depends on all earlier ones. Translation is in inertial
 coordinates: SE(3) and SO(3) × R³ are the same manifold, and the exponential chart of SE(3)
 would only couple position into the attitude's chart for no gain.
 """

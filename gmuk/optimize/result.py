@@ -168,8 +168,12 @@ class OptimalControlResult:
     t : ndarray (N,)
         Distinct node times (s).
     mesh : Mesh
-    body_names, body_kinds, body_dofs : tuple
-        The physical bodies, in System order ("point" or "rigid").
+    body_names : tuple of str
+        The physical bodies, in System order.
+    body_kinds : tuple of str
+        "point" or "rigid", per body.
+    body_dofs : tuple of int
+        3 or 6, per body.
     y : ndarray (N, n_y)
         Nodal states, per body: point mass [r_N (3), v_N (3)] (m, m/s); rigid body
         [r_N (3), ω (3), v_B (3)] (m, rad/s, m/s). See :attr:`r_N`, :attr:`g_NB` …
