@@ -40,7 +40,7 @@ import numpy as np
 
 from gmuk.bodies import Body, BodyKind
 from gmuk.constraints.holonomic import HolonomicConstraint, NonholonomicConstraint
-from gmuk.constraints.inequality import InequalityConstraint, PlaneBound
+from gmuk.constraints.inequality import InequalityConstraint, PlaneBound, TrackingErrorBound
 from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
 from gmuk.forces.gravity import PointMassGravity
@@ -271,3 +271,16 @@ def _plane_value(c: PlaneBound, q: tuple[Any, ...], nu: tuple[Any, ...], t: floa
     qb = q[0]
     r = qb[:3, 3] if qb.shape == (4, 4) else qb
     return _column(c.normal).T @ r
+
+
+@register_casadi_form(TrackingErrorBound, "casadi_value")
+def _tracking_value(c: TrackingErrorBound, q: tuple[Any, ...], nu: tuple[Any, ...], t: Any) -> Any:
+    ca = _ca()
+    if not isinstance(t, (int, float, np.floating)):  # the reference is numeric in t
+        raise DefinitionError(f"TrackingErrorBound {c.name!r} needs a numeric time")
+    r_r, v_r, _ = c.reference_kinematics(float(t))
+    err = q[0] - _column(r_r) if c.quantity == "position" else nu[0] - _column(v_r)
+    bound = float(c.bound(float(t))[0])
+    if c.form == "norm":
+        return ca.norm_2(err) - bound
+    return 0.5 * (ca.sumsqr(err) - bound**2)

@@ -168,3 +168,24 @@ def test_mixed_degrees_and_the_mapped_mesh_agree_where_they_coincide(monkeypatch
     assert abs(unrolled.objective - mapped.objective) < 1e-9 * mapped.objective
     mixed = problem.solve(Mesh(np.linspace(0.0, 30.0, 151), [3, 4] * 75))
     assert mixed.success and abs(mixed.objective / mapped.objective - 1.0) < 1e-2
+
+
+class Line:
+    """A reference moving along x at 1 m/s."""
+
+    def kinematics(self, t):
+        return np.array([t, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]), np.zeros(3)
+
+
+def test_a_tracking_error_bound_holds_at_every_node():
+    mass = gmuk.PointMass("p", 1.0)
+    bound = gmuk.TrackingErrorBound(mass, Line(), 0.1, form="squared", name="near")
+    system = gmuk.System([mass], [bound])
+    # start 0.05 m off the reference, at rest: the control must catch it up within 0.1 m
+    state = system.state(r={"p": [0.0, 0.05, 0.0]}, v={"p": [0.0, 0.0, 0.0]})
+    result = OptimalControlProblem(system, state, 4.0).solve(Mesh.uniform(0.0, 4.0, 16, 3))
+    err = result.r_N[:, 0] - np.stack([result.t, 0 * result.t, 0 * result.t], axis=1)
+    assert result.path["near"].t[0] > 0.0  # the reference needs numeric times: unrolled
+    assert np.linalg.norm(err, axis=1).max() <= 0.1 + 1e-7
+    assert np.linalg.norm(err, axis=1).max() > 0.1 - 1e-6  # the bound is reached
+    assert result.path["near"].value.shape == (result.mesh.n_nodes - 1,)
