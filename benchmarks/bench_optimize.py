@@ -13,7 +13,9 @@ Both in the same process, alternating, after one warm-up each; medians of ``--re
 the total (building the NLP and the solver, and IPOPT's solve), with the split. ``--table``
 also prints the objective under uniform and adaptive mesh refinement (docs/optimize.rst).
 
-Run: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_optimize.py [--table]
+``--slew`` adds the rigid-body table (a 90° rest-to-rest slew; docs/optimize.rst).
+
+Run: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_optimize.py [--table] [--slew]
 """
 
 from __future__ import annotations
@@ -113,16 +115,64 @@ def table() -> None:
         )
 
 
+def slew() -> None:
+    """Minimum-effort rest-to-rest slew of one rigid body, 90° about (1, 1, 1)/√3 in 60 s."""
+    import numpy as np
+
+    import gmuk
+    from gmuk.lie import so3
+
+    J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
+    body = gmuk.RigidBody("sat", 100.0, J)
+    system = gmuk.System([body])
+    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
+    gf = np.eye(4)
+    gf[:3, :3] = so3.exp(0.5 * np.pi * np.ones(3) / np.sqrt(3.0))
+    final = {"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
+    print("rigid-body slew, degree 4; re-simulated with System.simulate (DOP853, rtol 1e-11)")
+    print(
+        "| elements | objective | max(|RᵀR − I|, |det R − 1|) | final attitude error (rad) | "
+        "re-simulated, max error at the nodes (rad) | IPOPT iterations | total (s) |"
+    )
+    print("|---:|---:|---:|---:|---:|---:|---:|")
+    for n in (6, 12, 24, 48):
+        tic = time.perf_counter()
+        r = OptimalControlProblem(system, state, 60.0, final=final).solve(
+            Mesh.uniform(0.0, 60.0, n, 4)
+        )
+        total = time.perf_counter() - tic
+        R = r.R_NB[:, 0]
+        orth = max(
+            np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(),
+            np.abs(np.linalg.det(R) - 1.0).max(),
+        )
+        driven = gmuk.System([body], controllers=[r.controller()])
+        traj = driven.simulate(state, (0.0, 60.0), t_eval=r.t, rtol=1e-11, atol=1e-12)
+        err = np.linalg.norm(
+            so3.log(np.swapaxes(traj.g_NB[:, 0, :3, :3], -1, -2) @ R), axis=-1
+        ).max()
+        final_err = np.linalg.norm(so3.log(R[-1].T @ gf[:3, :3]))
+        print(
+            f"| {n} | {r.objective:.10e} | {orth:.1e} | {final_err:.1e} | {err:.1e} | "
+            f"{r.iterations} | {total:.2f} |"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--elements", type=int, default=150)
     parser.add_argument("--degree", type=int, default=3)
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--table", action="store_true", help="also the refinement tables")
+    parser.add_argument("--slew", action="store_true", help="also the rigid-body slew table")
+    parser.add_argument("--slew-only", action="store_true", help="only the slew table")
     args = parser.parse_args()
-    compare(args.elements, args.degree, args.repeat)
-    if args.table:
+    if not args.slew_only:
+        compare(args.elements, args.degree, args.repeat)
+    if args.table and not args.slew_only:
         table()
+    if args.slew or args.slew_only:
+        slew()
 
 
 if __name__ == "__main__":
