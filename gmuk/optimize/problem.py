@@ -110,8 +110,10 @@ class OptimalControlProblem:
         A running cost ``L(t, q, nu, u)`` (CasADi scalar) replacing ``uᵀM⁻¹u``: q, nu as
         for constraints (per physical body), u per body (3×1 or 6×1 CasADi columns).
     max_element_rotation : float
-        Bound (rad) on each component of θ within an element (≤ 1.5; default 1.5). Refine
-        the mesh if a body turns faster than that per element.
+        Bound (rad) on each component of the local exponential coordinates: θ within an
+        element and φ, an element's start against its reference attitude from the guess
+        (≤ 1.5; default 1.5). Refine the mesh if a body turns faster than that per element,
+        and start from a closer guess (``guess=``) if the optimum turns that far from it.
 
     Raises
     ------
@@ -911,7 +913,7 @@ class _Transcription:
         nr = pb.n_th // 3
         s = (t - pb.t0) / (pb.tf - pb.t0)
         if guess is not None:
-            Yg = guess.states_at(t, pb)
+            Yg = guess.states_at(t)
             Ug = guess.control(t)
             Rg = guess.attitudes_at(t)
         else:

@@ -314,8 +314,11 @@ class OptimalControlResult:
         out = self._per_element(t, self.u)
         return out[0] if np.ndim(t) == 0 else out
 
-    def states_at(self, t: Any, problem: Any = None) -> FloatArray:
-        """The state rows y (len(t), n_y) interpolated in each element."""
+    def states_at(self, t: Any) -> FloatArray:
+        """The state rows y (len(t), n_y) at times t: the degree-p interpolant of the nodal
+        states in each element (the method's own state polynomial, the integral of the
+        interpolated F, has degree p + 1; they agree at the nodes and differ between them
+        by the discretisation error)."""
         return self._per_element(t, self.y)
 
     def attitudes_at(self, t: Any) -> FloatArray:
