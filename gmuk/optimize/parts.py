@@ -44,7 +44,12 @@ from gmuk.constraints.inequality import InequalityConstraint, PlaneBound, Tracki
 from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
 from gmuk.forces.gravity import PointMassGravity
-from gmuk.forces.mechanical import AppliedWrench, LinearSpringDamper, UniformGravity
+from gmuk.forces.mechanical import (
+    AppliedWrench,
+    LinearSpringDamper,
+    SpringDamper,
+    UniformGravity,
+)
 
 __all__ = ["register_casadi_form"]
 
@@ -284,3 +289,41 @@ def _tracking_value(c: TrackingErrorBound, q: tuple[Any, ...], nu: tuple[Any, ..
     if c.form == "norm":
         return ca.norm_2(err) - bound
     return 0.5 * (ca.sumsqr(err) - bound**2)
+
+
+def _spring_point(q: Any, nu: Any, body: Body, p_B: Any) -> tuple[Any, Any]:
+    """World position and velocity of a body point (as SpringDamper._point)."""
+    ca = _ca()
+    if body.kind is BodyKind.RIGID:
+        R, p = q[:3, :3], _column(p_B)
+        return q[:3, 3] + R @ p, R @ (nu[3:] + ca.cross(nu[:3], p))
+    return q, nu
+
+
+def _spring_to_body(q: Any, body: Body, p_B: Any, f_N: Any) -> Any:
+    ca = _ca()
+    if body.kind is not BodyKind.RIGID:
+        return f_N
+    f_B = q[:3, :3].T @ f_N
+    return ca.vertcat(ca.cross(_column(p_B), f_B), f_B)
+
+
+@register_casadi_form(SpringDamper, "casadi_wrenches")
+def _spring_wrenches(
+    m: SpringDamper, t: Any, q: tuple[Any, ...], nu: tuple[Any, ...], bodies: tuple[Body, ...]
+) -> list[Any]:
+    ca = _ca()
+    x_a, v_a = _spring_point(q[0], nu[0], bodies[0], m.point_a)
+    if m.anchored:
+        x_b, v_b = _column(m.point_b), ca.DM.zeros(3, 1)
+    else:
+        x_b, v_b = _spring_point(q[1], nu[1], bodies[1], m.point_b)
+    d = x_b - x_a
+    length = ca.norm_2(d)
+    u = d / length
+    tension = m.k * (length - m.l0) + m.c * ca.dot(u, v_b - v_a)
+    f_a = tension * u
+    out = [_spring_to_body(q[0], bodies[0], m.point_a, f_a)]
+    if not m.anchored:
+        out.append(_spring_to_body(q[1], bodies[1], m.point_b, -f_a))
+    return out
