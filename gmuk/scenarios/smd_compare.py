@@ -108,6 +108,8 @@ def compare_case(
         "x_rms_difference_m": float(np.sqrt(np.mean((x_uk - x_d) ** 2))),
         "v_max_abs_difference_m_s": float(np.abs(v_uk - v_d).max()),
         "u_rms_difference_m_s2": float(np.sqrt(np.mean((u_uk - u_d) ** 2))),
+        "x_direct_min_on_grid_m": float(x_d.min()),
+        "x_direct_max_on_grid_m": float(x_d.max()),
         "x_final_uk": float(x_uk[-1]),
         "x_final_direct": float(x_d[-1]),
         "u_final_uk": float(u_uk[-1]),
