@@ -19,6 +19,7 @@ __all__ = [
     "InconsistentConstraintsError",
     "InconsistentConstraintsWarning",
     "InertiaError",
+    "MissingDependencyError",
     "NonFiniteError",
     "NotOnGroupError",
     "OptimizationError",
@@ -99,6 +100,10 @@ class DegreeError(GmukError, ValueError):
 class DomainError(GmukError, ValueError):
     """A model was evaluated where it is not defined (a gravity field at its origin, or where
     its series does not give a finite value)."""
+
+
+class MissingDependencyError(GmukError, ImportError):
+    """An optional dependency is not installed (the message gives the pip command)."""
 
 
 class OptimizationError(GmukError, RuntimeError):

@@ -41,7 +41,7 @@ import numpy as np
 from gmuk.bodies import Body, BodyKind
 from gmuk.constraints.holonomic import HolonomicConstraint, NonholonomicConstraint
 from gmuk.constraints.inequality import InequalityConstraint, PlaneBound, TrackingErrorBound
-from gmuk.errors import DefinitionError
+from gmuk.errors import DefinitionError, MissingDependencyError
 from gmuk.forces.base import ForceModel
 from gmuk.forces.gravity import PointMassGravity
 from gmuk.forces.mechanical import (
@@ -89,8 +89,12 @@ def register_casadi_form(cls: type, method: str) -> Callable[[Callable[..., Any]
 
 
 def _ca() -> Any:
-    import casadi
-
+    try:
+        import casadi
+    except ImportError:
+        raise MissingDependencyError(
+            'gmuk.optimize needs CasADi: pip install "gmuk[optimize]" (or pip install casadi)'
+        ) from None
     return casadi
 
 

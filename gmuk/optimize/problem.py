@@ -117,6 +117,8 @@ class OptimalControlProblem:
 
     Raises
     ------
+    MissingDependencyError
+        When CasADi is not installed.
     DefinitionError
         For a part gmuk cannot transcribe (naming it), controllers, a bad time span or bad
         boundary conditions.
@@ -137,6 +139,7 @@ class OptimalControlProblem:
     ) -> None:
         from gmuk.system import System
 
+        parts._ca()  # CasADi is installed, or a MissingDependencyError with the pip command
         if not isinstance(system, System):
             raise DefinitionError(f"system must be a gmuk.System; got {type(system).__name__}")
         if not isinstance(initial, State) or initial.layout != system.layout:

@@ -175,3 +175,10 @@ def test_a_part_that_turns_symbols_into_nan_is_named():
     state = system.state(r={"p": [1.0, 0.0, 0.0]}, v={"p": [0.0, 0.0, 0.0]})
     with pytest.raises(DefinitionError, match=r"constraint 'x-float' \(FloatValue\).*float\(\)"):
         OptimalControlProblem(system, state, 1.0).solve(n_elements=3)
+
+
+def test_a_missing_casadi_says_how_to_install_it(monkeypatch):
+    _, system, state = _mass_system()
+    monkeypatch.setitem(sys.modules, "casadi", None)  # import casadi now raises ImportError
+    with pytest.raises(gmuk.errors.MissingDependencyError, match=r'pip install "gmuk\[optimize\]"'):
+        OptimalControlProblem(system, state, 1.0)
