@@ -150,9 +150,10 @@ _FORCE_FIX = (
 
 
 def force_terms(
-    model: ForceModel, t: float, q: Sequence[Any], nu: Sequence[Any], bodies: Sequence[Body]
+    model: ForceModel, t: Any, q: Sequence[Any], nu: Sequence[Any], bodies: Sequence[Body]
 ) -> list[Any]:
-    """The model's generalized forces on ``bodies`` as CasADi columns (3×1 or 6×1)."""
+    """The model's generalized forces on ``bodies`` as CasADi columns (3×1 or 6×1); ``t`` a
+    float or a CasADi symbol."""
     who = f"force model {model.name!r} ({type(model).__name__})"
     coupled = _lookup(model, "casadi_wrenches")
     if coupled is not None:
@@ -180,7 +181,7 @@ def force_terms(
 
 
 def inequality_value(
-    c: InequalityConstraint, q: tuple[Any, ...], nu: tuple[Any, ...], t: float
+    c: InequalityConstraint, q: tuple[Any, ...], nu: tuple[Any, ...], t: Any
 ) -> Any:
     """h(q, ν, t) of an inequality as a CasADi scalar."""
     who = f"inequality constraint {c.name!r} ({type(c).__name__})"
@@ -189,7 +190,7 @@ def inequality_value(
     return _as_column(_call(fn, (q, nu, t), who, fix), who, 1)
 
 
-def equality_residual(c: Any, q: tuple[Any, ...], nu: tuple[Any, ...], t: float) -> Any:
+def equality_residual(c: Any, q: tuple[Any, ...], nu: tuple[Any, ...], t: Any) -> Any:
     """φ(q, t) or ψ(q, ν, t) of an equality constraint as a CasADi column."""
     who = f"constraint {c.name!r} ({type(c).__name__})"
     fix = "give it a casadi_residual method written with CasADi operations"

@@ -45,6 +45,7 @@ would only couple position into the attitude's chart for no gain.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import tempfile
 import time
@@ -553,8 +554,7 @@ class OptimalControlProblem:
                 break
             mesh, guess = mesh.split(counts), result
         assert result is not None
-        object.__setattr__(result, "refinement", history)
-        return result
+        return dataclasses.replace(result, refinement=history)
 
 
 class _Transcription:

@@ -226,6 +226,12 @@ class OptimalControlResult:
     _kkt: Callable[[], dict[str, float]] = field(repr=False)
     refinement: list[RefinementStep] | None = None
 
+    def __repr__(self) -> str:
+        return (
+            f"OptimalControlResult(status={self.status!r}, objective={self.objective:.10g}, "
+            f"iterations={self.iterations}, {self.mesh!r}, bodies={list(self.body_names)})"
+        )
+
     # ------------------------------------------------------------------ layout
     def _slots(self) -> dict[str, tuple[str, int, int, int]]:
         """name → (kind, first state row, first control row, rigid index or point index)."""
