@@ -19,8 +19,10 @@ __all__ = [
     "InconsistentConstraintsError",
     "InconsistentConstraintsWarning",
     "InertiaError",
+    "MissingDependencyError",
     "NonFiniteError",
     "NotOnGroupError",
+    "OptimizationError",
     "OrbitError",
     "PluginWarning",
     "ShapeError",
@@ -98,6 +100,31 @@ class DegreeError(GmukError, ValueError):
 class DomainError(GmukError, ValueError):
     """A model was evaluated where it is not defined (a gravity field at its origin, or where
     its series does not give a finite value)."""
+
+
+class MissingDependencyError(GmukError, ImportError):
+    """An optional dependency is not installed (the message gives the pip command)."""
+
+
+class OptimizationError(GmukError, RuntimeError):
+    """An optimal-control problem (:mod:`gmuk.optimize`) could not be solved.
+
+    Attributes
+    ----------
+    status : str
+        IPOPT's return status (e.g. ``"Infeasible_Problem_Detected"``,
+        ``"Maximum_Iterations_Exceeded"``, ``"Maximum_CpuTime_Exceeded"``), or
+        ``"Infeasible_Bounds"`` when gmuk found the bounds or boundary conditions infeasible
+        before solving.
+    result : object or None
+        The :class:`gmuk.optimize.OptimalControlResult` of the last iterate, when the solver
+        ran (its ``log`` holds IPOPT's iteration log when it was asked for).
+    """
+
+    def __init__(self, message: str, status: str, result: object | None = None) -> None:
+        super().__init__(message)
+        self.status = status
+        self.result = result
 
 
 class GmukWarning(UserWarning):

@@ -76,6 +76,7 @@ SCENARIOS: dict[str, str] = {
     "smd-gt": "gmuk.scenarios.smd:GT",
     "smd-lt": "gmuk.scenarios.smd:LT",
     "smd-bi": "gmuk.scenarios.smd:BI",
+    "smd-compare": "gmuk.scenarios.smd_compare:SCENARIO",
     "maintenance": "gmuk.scenarios.maintenance:SCENARIO",
 }
 

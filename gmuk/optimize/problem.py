@@ -1,0 +1,1326 @@
+"""Direct Lobatto (LGL) collocation of a gmuk System: transcription, solve, mesh refinement.
+
+The continuous problem, for the physical bodies of a :class:`gmuk.System` (point masses and
+rigid bodies; the slack coordinates of its inequality constraints are not used), is::
+
+    minimise  J = ∫ uᵀ M⁻¹ u dt   (or ∫ L(t, q, ν, u) dt)
+    subject to  M ν̇ = Q(t, q, ν) + u            (rigid bodies: + ad*_V 𝕀V, Eq. 10b)
+                q̇ from ν                        (ṙ = v; Ṙ = R ω^, ṙ_N = R v_B)
+                l ≤ h(q, ν, t) ≤ u                every InequalityConstraint
+                φ(q, t) = 0, ψ(q, ν, t) = 0       holonomic / nonholonomic constraints
+                the initial state, and any given part of the final state,
+
+with u the generalized control force of every degree of freedom (N for a point mass,
+[L; f] in the body frame for a rigid body) and M the System's mass matrix, so that J is the
+Gauss-principle cost of McCann (2020) §6.4.
+
+Transcription
+-------------
+Every element ``[t_k, t_{k+1}]`` of the :class:`~gmuk.optimize.Mesh` carries the p_k + 1 LGL
+nodes; states and controls are unknowns at every distinct node (boundary nodes shared, so
+states and controls are continuous there). The dynamics ``ẏ = F(t, y, u)`` are imposed in
+integral form (Lobatto IIIA collocation, order 2p at the element ends)::
+
+    y_j = y_0 + (h/2) Σ_l A_jl F_l,   j = 1 … p,
+
+with A the LGL integration matrix (:func:`~gmuk.optimize.lgl.lgl_integration_matrix`); the
+cost is the LGL quadrature ``Σ_i W_i uᵢᵀ M⁻¹ uᵢ``; path constraints are imposed at every node
+after the first (the initial state is fixed and checked before solving).
+
+A rigid body's attitude is kept on SO(3) by local exponential coordinates about each
+element's start: ``R(t) = R_k exp(θ(t)^)`` with ``θ(t_k) = 0`` and ``θ̇ = J_r(θ)⁻¹ ω``, and
+the start itself ``R_k = R̄_k exp(φ_k^)`` about a constant reference R̄_k taken from the
+starting guess (an NLP parameter; φ_0 = 0). Three rows per element boundary,
+``vee(skew(R_{k+1}ᵀ R_k exp(θ_p^))) = 0``, join the elements; the same form fixes a final
+attitude. The unknowns are θ (3 per node after the first of each element), φ (3 per
+element), ω, v_B and r_N; ``ṙ_N = R v_B``. Every attitude gmuk reports is a product of
+exponentials, so it is a rotation to rounding error whatever the solver's iterates; no
+unit-norm or orthogonality constraint is needed, and θ and φ stay small (bounded per
+element), away from the chart's singularity at ‖θ‖ = 2π. Unknown start attitudes, rather
+than the chain ``R_{k+1} = R_k exp(θ_p)``, keep the NLP sparse: with the chain every element
+depends on all earlier ones. Translation is in inertial
+coordinates: SE(3) and SO(3) × R³ are the same manifold, and the exponential chart of SE(3)
+would only couple position into the attitude's chart for no gain.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import tempfile
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gmuk._validation import FloatArray, as_array, check_se3, real_number
+from gmuk.bodies import Body, BodyKind, RigidBody
+from gmuk.constraints.inequality import InequalityConstraint
+from gmuk.errors import DefinitionError, OptimizationError
+from gmuk.lie import so3
+from gmuk.optimize import _so3, parts
+from gmuk.optimize.lgl import lgl_integration_matrix, lgl_nodes
+from gmuk.optimize.mesh import Mesh, split_counts
+from gmuk.optimize.result import OptimalControlResult, PathConstraintResult, RefinementStep
+from gmuk.state import State
+
+if TYPE_CHECKING:
+    from gmuk.system import System
+
+__all__ = ["OptimalControlProblem"]
+
+#: Relative tolerance of the checks of boundary conditions against the path constraints.
+BOUNDARY_TOL = 1e-9
+
+CostFunction = Callable[[float, tuple[Any, ...], tuple[Any, ...], tuple[Any, ...]], Any]
+
+
+@dataclass(frozen=True)
+class _BodyPlan:
+    body: Body
+    rigid: bool
+    y: int  # first row in Y: point mass [r(3) v(3)], rigid [r_N(3) ω(3) v_B(3)]
+    u: int  # first row in U: 3 (point mass) or 6 (rigid)
+    th: int  # first row in Θ (rigid only; −1 otherwise)
+
+
+class OptimalControlProblem:
+    """The optimal control of a System's bodies from a given start, transcribed by LGL
+    collocation and solved with IPOPT through CasADi.
+
+    Parameters
+    ----------
+    system : System
+        Point masses and rigid bodies; forces with a CasADi form (see
+        :mod:`gmuk.optimize.parts`); constraints that are inequalities (their bounds become
+        path constraints, not their slack form), holonomic or nonholonomic. Unmodeled forces
+        are left out (the plan, like the Udwadia–Kalaba solve, knows only the modeled ones);
+        controllers are refused (the optimum is the control).
+    initial : State
+        The start (its time is t0); only the physical bodies' entries are used.
+    t_final : float
+        End time tf > t0 (s).
+    final : State or mapping, optional
+        Final conditions: a State (every physical body's configuration and velocity fixed),
+        or a mapping with any of the keys of :meth:`gmuk.System.state` — ``"g"``, ``"V"``
+        (rigid), ``"r"``, ``"v"`` (point masses), each a mapping body name → value — fixing
+        just those. Default: free.
+    cost : callable, optional
+        A running cost ``L(t, q, nu, u)`` (CasADi scalar) replacing ``uᵀM⁻¹u``: q, nu as
+        for constraints (per physical body), u per body (3×1 or 6×1 CasADi columns).
+    max_element_rotation : float
+        Bound (rad) on each component of the local exponential coordinates: θ within an
+        element and φ, an element's start against its reference attitude from the guess
+        (≤ 1.5; default 1.5). Refine the mesh if a body turns faster than that per element,
+        and start from a closer guess (``guess=``) if the optimum turns that far from it.
+
+    Raises
+    ------
+    MissingDependencyError
+        When CasADi is not installed.
+    DefinitionError
+        For a part gmuk cannot transcribe (naming it), controllers, a bad time span or bad
+        boundary conditions.
+    OptimizationError
+        With status ``"Infeasible_Bounds"`` when the initial state or the given final state
+        violates a path constraint (checked before solving).
+    """
+
+    def __init__(
+        self,
+        system: System,
+        initial: State,
+        t_final: float,
+        *,
+        final: State | Mapping[str, Any] | None = None,
+        cost: CostFunction | None = None,
+        max_element_rotation: float = 1.5,
+    ) -> None:
+        from gmuk.system import System
+
+        parts._ca()  # CasADi is installed, or a MissingDependencyError with the pip command
+        if not isinstance(system, System):
+            raise DefinitionError(f"system must be a gmuk.System; got {type(system).__name__}")
+        if not isinstance(initial, State) or initial.layout != system.layout:
+            raise DefinitionError("initial must be a State of this System (system.state(...))")
+        self.system = system
+        self.t0 = float(initial.t)
+        self.tf = real_number(t_final, "t_final (s)")
+        if not self.tf > self.t0:
+            raise DefinitionError(f"t_final must be > the initial time {self.t0}; got {self.tf}")
+        if cost is not None and not callable(cost):
+            raise DefinitionError(f"cost must be a callable L(t, q, nu, u); got {cost!r:.60}")
+        self.cost = cost
+        rot = real_number(max_element_rotation, "max_element_rotation (rad)", positive=True)
+        if rot > 1.5:
+            raise DefinitionError(f"max_element_rotation must be in (0, 1.5] rad; got {rot}")
+        self.max_element_rotation = rot
+        if system.controllers:
+            raise DefinitionError(
+                "the System has controllers "
+                f"{[c.name for c in system.controllers]}; gmuk.optimize computes the control "
+                "itself: build the System without them"
+            )
+        owned = {b.name for c in system.constraints for b in c.owned_bodies}
+        self.bodies: tuple[Body, ...] = tuple(b for b in system.bodies if b.name not in owned)
+        plans, y, u, th = [], 0, 0, 0
+        for b in self.bodies:
+            if b.kind is BodyKind.SLACK:
+                raise DefinitionError(
+                    f"body {b.name!r} is a SlackCoordinate of no inequality constraint; "
+                    "gmuk.optimize transcribes point masses and rigid bodies"
+                )
+            rigid = b.kind is BodyKind.RIGID
+            plans.append(_BodyPlan(b, rigid, y, u, th if rigid else -1))
+            y += 9 if rigid else 6
+            u += 6 if rigid else 3
+            th += 3 if rigid else 0
+        self._plans = plans
+        self._by_name = {p.body.name: p for p in plans}
+        self.n_y, self.n_u, self.n_th = y, u, th
+        self._forces = self._force_plan()
+        self._constraints = [
+            (c, parts.constraint_kind(c), self._constraint_plans(c)) for c in system.constraints
+        ]
+        self._M_inv = np.zeros((u, u))
+        for p in plans:
+            Minv = np.linalg.inv(p.body.mass_matrix())
+            d = p.body.dof
+            self._M_inv[p.u : p.u + d, p.u : p.u + d] = Minv
+        self.y0, self.R0 = self._initial_values(initial)
+        self._final_y, self._final_R = self._final_values(final)
+        self._check_boundaries()
+
+    # ------------------------------------------------------------------ set-up
+    def _force_plan(self) -> list[tuple[Any, list[_BodyPlan]]]:
+        out = []
+        for f in self.system.forces:
+            if not f.modeled:
+                continue
+            if f.bodies is None:
+                bodies = [p for p in self._plans if p.body.kind in f.acts_on]
+            else:
+                names = [b if isinstance(b, str) else b.name for b in f.bodies]
+                if not all(n in self._by_name for n in names):  # acts on slack coordinates
+                    if all(n not in self._by_name for n in names):
+                        continue
+                    raise DefinitionError(
+                        f"force model {f.name!r} acts on slack coordinates and bodies together"
+                    )
+                bodies = [self._by_name[n] for n in names]
+            if bodies:
+                out.append((f, bodies))
+        return out
+
+    def _constraint_plans(self, c: Any) -> list[_BodyPlan]:
+        refs = c.physical_bodies if isinstance(c, InequalityConstraint) else c.bodies
+        return [self._by_name[b if isinstance(b, str) else b.name] for b in refs]
+
+    def _initial_values(self, state: State) -> tuple[FloatArray, list[FloatArray]]:
+        y = np.zeros(self.n_y)
+        Rs = []
+        for p in self._plans:
+            if p.rigid:
+                g, V = state.pose(p.body), state.twist(p.body)
+                y[p.y : p.y + 3] = g[:3, 3]
+                y[p.y + 3 : p.y + 9] = V
+                Rs.append(g[:3, :3].copy())
+            else:
+                y[p.y : p.y + 3] = state.position(p.body)
+                y[p.y + 3 : p.y + 6] = state.velocity(p.body)
+        return y, Rs
+
+    def _final_values(
+        self, final: State | Mapping[str, Any] | None
+    ) -> tuple[dict[int, float], dict[str, FloatArray]]:
+        """Fixed final entries of Y (row → value) and final attitudes (rigid name → R)."""
+        fixed: dict[int, float] = {}
+        Rf: dict[str, FloatArray] = {}
+        if final is None:
+            return fixed, Rf
+        if isinstance(final, State):
+            if final.layout != self.system.layout:
+                raise DefinitionError("final must be a State of this System or a mapping")
+            spec: dict[str, dict[str, Any]] = {"g": {}, "V": {}, "r": {}, "v": {}}
+            for p in self._plans:
+                if p.rigid:
+                    spec["g"][p.body.name] = final.pose(p.body)
+                    spec["V"][p.body.name] = final.twist(p.body)
+                else:
+                    spec["r"][p.body.name] = final.position(p.body)
+                    spec["v"][p.body.name] = final.velocity(p.body)
+        elif isinstance(final, Mapping):
+            unknown = set(final) - {"g", "V", "r", "v"}
+            if unknown:
+                raise DefinitionError(
+                    f"final conditions take the keys 'g', 'V', 'r', 'v'; got {sorted(unknown)}"
+                )
+            spec = {k: dict(final.get(k) or {}) for k in ("g", "V", "r", "v")}
+        else:
+            raise DefinitionError(
+                f"final must be a State, a mapping or None; got {type(final).__name__}"
+            )
+        for key, values in spec.items():
+            for name, value in values.items():
+                plan = self._by_name.get(name)
+                if plan is None:
+                    raise DefinitionError(
+                        f"final[{key!r}] names unknown body {name!r}; bodies are "
+                        f"{sorted(self._by_name)}"
+                    )
+                if plan.rigid != (key in ("g", "V")):
+                    raise DefinitionError(
+                        f"final[{key!r}][{name!r}]: {key!r} is for "
+                        f"{'rigid bodies' if key in ('g', 'V') else 'point masses'}; "
+                        f"{name!r} is a {plan.body.kind} body"
+                    )
+                if key == "g":
+                    g = check_se3(value, f"final['g'][{name!r}]")
+                    Rf[name] = g[:3, :3].copy()
+                    rows, vals = range(plan.y, plan.y + 3), g[:3, 3]
+                elif key == "V":
+                    vals = as_array(value, (6,), f"final['V'][{name!r}]", batch=False)
+                    rows = range(plan.y + 3, plan.y + 9)
+                else:
+                    vals = as_array(value, (3,), f"final[{key!r}][{name!r}]", batch=False)
+                    rows = range(
+                        plan.y + (0 if key == "r" else 3), plan.y + (3 if key == "r" else 6)
+                    )
+                fixed.update({r: float(v) for r, v in zip(rows, vals, strict=True)})
+        return fixed, Rf
+
+    def _body_qv(self, plans: Sequence[_BodyPlan], y: FloatArray, Rs: Sequence[Any]) -> Any:
+        """Numeric q, ν tuples of ``plans`` from a Y column and the rigid attitudes."""
+        q, nu = [], []
+        for p in plans:
+            if p.rigid:
+                g = np.eye(4)
+                g[:3, :3] = Rs[p.th // 3]
+                g[:3, 3] = y[p.y : p.y + 3]
+                q.append(g)
+                nu.append(y[p.y + 3 : p.y + 9].copy())
+            else:
+                q.append(y[p.y : p.y + 3].copy())
+                nu.append(y[p.y + 3 : p.y + 6].copy())
+        return tuple(q), tuple(nu)
+
+    def _check_boundaries(self) -> None:
+        """Path constraints at t0 (and at tf where the final state fixes their bodies)."""
+        problems = []
+        ends = [("initial", self.t0, self.y0, self.R0, self._plans)]
+        complete = [p for p in self._plans if self._final_fixes(p)]
+        if complete:
+            yf = self.y0.copy()
+            for r, v in self._final_y.items():
+                yf[r] = v
+            Rf = [self._final_R.get(p.body.name, np.eye(3)) for p in self._plans if p.rigid]
+            ends.append(("final", self.tf, yf, Rf, complete))
+        for label, t, y, Rs, known in ends:
+            for c, kind, plans in self._constraints:
+                if not all(p in known for p in plans):
+                    continue
+                q, nu = self._body_qv(plans, y, Rs)
+                if kind == "inequality":
+                    h = float(np.asarray(c.value(q, nu, t), dtype=float).reshape(-1)[0])
+                    for bd in c.bounds:
+                        margin = bd.margin(h)
+                        if margin < -BOUNDARY_TOL * max(1.0, abs(bd.value)):
+                            problems.append(
+                                f"the {label} state violates {c.name!r}: {bd.label} "
+                                f"{c.unit} with h = {h:.9g} (outside by {-margin:.3g})"
+                            )
+                else:
+                    args = (q, t) if kind == "holonomic" else (q, nu, t)
+                    res = np.asarray(c.residual(*args), dtype=float).reshape(-1)
+                    if np.abs(res).max(initial=0.0) > 1e-8:
+                        problems.append(
+                            f"the {label} state violates the {kind} constraint {c.name!r}: "
+                            f"max abs residual {np.abs(res).max():.3g}"
+                        )
+        if problems:
+            raise OptimizationError(
+                "infeasible before solving: " + "; ".join(problems), "Infeasible_Bounds"
+            )
+
+    def _final_fixes(self, p: _BodyPlan) -> bool:
+        rows = range(p.y, p.y + (9 if p.rigid else 6))
+        return all(r in self._final_y for r in rows) and (
+            not p.rigid or p.body.name in self._final_R
+        )
+
+    # ------------------------------------------------------------------ dynamics
+    def _rhs(self, t: Any, y: Any, u: Any, Rs: Sequence[Any]) -> Any:
+        """F(t, y, u) (n_y × 1) for CasADi SX or DM columns y, u and attitudes Rs."""
+        import casadi as ca
+
+        q, nu = self._casadi_qv(self._plans, y, Rs)
+        gen = [ca.DM.zeros(p.body.dof, 1) for p in self._plans]
+        for f, plans in self._forces:
+            idx = [self._plans.index(p) for p in plans]
+            terms = parts.force_terms(
+                f, t, [q[i] for i in idx], [nu[i] for i in idx], [p.body for p in plans]
+            )
+            for i, w in zip(idx, terms, strict=True):
+                gen[i] = gen[i] + w
+        blocks = []
+        for i, p in enumerate(self._plans):
+            Q = gen[i] + u[p.u : p.u + p.body.dof]
+            if p.rigid:
+                body = p.body
+                assert isinstance(body, RigidBody)
+                J = ca.DM(body.inertia)
+                w, v = y[p.y + 3 : p.y + 6], y[p.y + 6 : p.y + 9]
+                w_dot = ca.DM(np.linalg.inv(body.inertia)) @ (ca.cross(J @ w, w) + Q[:3])
+                v_dot = ca.cross(v, w) + Q[3:] / body.mass
+                blocks += [Rs[p.th // 3] @ v, w_dot, v_dot]
+            else:
+                blocks += [y[p.y + 3 : p.y + 6], Q / p.body.mass]
+        return ca.vertcat(*blocks)
+
+    def _casadi_qv(self, plans: Sequence[_BodyPlan], y: Any, Rs: Sequence[Any]) -> Any:
+        import casadi as ca
+
+        q, nu = [], []
+        for p in plans:
+            if p.rigid:
+                top = ca.horzcat(Rs[p.th // 3], y[p.y : p.y + 3])
+                q.append(ca.vertcat(top, ca.DM([[0.0, 0.0, 0.0, 1.0]])))
+                nu.append(y[p.y + 3 : p.y + 9])
+            else:
+                q.append(y[p.y : p.y + 3])
+                nu.append(y[p.y + 3 : p.y + 6])
+        return tuple(q), tuple(nu)
+
+    def _theta_rate(self, theta: Any, y: Any) -> Any:
+        import casadi as ca
+
+        rates = []
+        for p in self._plans:
+            if p.rigid:
+                rates.append(_so3.theta_rate_casadi(theta[p.th : p.th + 3], y[p.y + 3 : p.y + 6]))
+        return ca.vertcat(*rates)
+
+    def _attitudes(self, R_start: Sequence[Any], theta: Any) -> list[Any]:
+        return [
+            R_start[p.th // 3] @ _so3.exp_casadi(theta[p.th : p.th + 3])
+            for p in self._plans
+            if p.rigid
+        ]
+
+    # ------------------------------------------------------------------ transcription
+    def transcribe(self, mesh: Mesh) -> _Transcription:
+        """Build the NLP on ``mesh`` (no solve); see :meth:`solve`."""
+        return _Transcription(self, mesh)
+
+    def solve(
+        self,
+        mesh: Mesh | None = None,
+        *,
+        n_elements: int = 50,
+        degree: int = 3,
+        guess: OptimalControlResult | None = None,
+        max_iter: int = 3000,
+        max_cpu_time: float = 120.0,
+        tol: float = 1e-8,
+        log: bool = False,
+        ipopt_options: Mapping[str, Any] | None = None,
+    ) -> OptimalControlResult:
+        """Transcribe on ``mesh`` and solve with IPOPT.
+
+        Parameters
+        ----------
+        mesh : Mesh, optional
+            Default ``Mesh.uniform(t0, tf, n_elements, degree)``.
+        n_elements, degree : int
+            Used when ``mesh`` is not given.
+        guess : OptimalControlResult, optional
+            A previous solution (any mesh) to start from; default: the initial state held
+            (moved linearly, and rotated about one axis, towards given final conditions).
+        max_iter : int
+            IPOPT's iteration limit.
+        max_cpu_time : float
+            IPOPT's CPU-time limit (s); also its wall-time limit. The solve never runs
+            longer.
+        tol : float
+            IPOPT's convergence tolerance.
+        log : bool
+            Keep IPOPT's iteration log in ``result.log`` (it is never printed).
+        ipopt_options : mapping, optional
+            Further IPOPT options (``{"mu_strategy": "adaptive"}``, ...).
+
+        Returns
+        -------
+        OptimalControlResult
+
+        Raises
+        ------
+        OptimizationError
+            When IPOPT does not converge; ``status`` is its return status and ``result``
+            the last iterate.
+        """
+        if mesh is None:
+            mesh = Mesh.uniform(self.t0, self.tf, n_elements, degree)
+        tic = time.perf_counter()
+        tr = self.transcribe(mesh)
+        built = time.perf_counter() - tic
+        result = tr.solve(
+            guess=guess,
+            max_iter=max_iter,
+            max_cpu_time=max_cpu_time,
+            tol=tol,
+            log=log,
+            ipopt_options=ipopt_options,
+            transcription_s=built,
+        )
+        if not result.success:
+            raise OptimizationError(
+                f"IPOPT did not solve the problem: {result.status} after {result.iterations} "
+                f"iterations (objective {result.objective:.6g}, max constraint violation "
+                f"{result.stats.get('constraint_violation', float('nan')):.3g}); "
+                + ("see result.log" if log else "solve with log=True for IPOPT's log"),
+                result.status,
+                result,
+            )
+        return result
+
+    def solve_adaptive(
+        self,
+        mesh: Mesh | None = None,
+        *,
+        tol: float = 1e-6,
+        max_rounds: int = 6,
+        max_elements: int = 2000,
+        n_elements: int = 20,
+        degree: int = 3,
+        **options: Any,
+    ) -> OptimalControlResult:
+        """Solve, estimate each element's error, split the elements above ``tol`` and
+        solve again from the previous solution, until every element is below ``tol``.
+
+        The error estimate of element k is the collocation defect between the nodes:
+        at 2p + 1 Gauss points inside the element the state polynomial
+        ``y(τ) = y_0 + (h/2) ∫ F̃`` (F̃ the interpolant of the nodal F) and the control
+        interpolant give ``d = F̃ − F(t, y(τ), u(τ))``; the estimate is
+        ``(h/2) ∫ |d| dτ`` per state component, relative to ``1 + max |y|`` over the
+        element, the largest over the components. Elements above ``tol`` are split into
+        ``⌈(e/tol)^(1/(p+1))⌉`` (2 to 4) equal parts.
+
+        Parameters
+        ----------
+        mesh : Mesh, optional
+            The first mesh (default ``n_elements`` uniform elements of ``degree``).
+        tol : float
+            Target relative error per element.
+        max_rounds : int
+            Solves at most (the last result is returned even if above ``tol``; its
+            ``refinement`` history says so).
+        max_elements : int
+            Stop refining before a mesh would exceed this many elements.
+        options
+            Passed to :meth:`solve`.
+
+        Returns
+        -------
+        OptimalControlResult
+            The last solve's, with ``refinement`` the list of :class:`RefinementStep`.
+        """
+        if mesh is None:
+            mesh = Mesh.uniform(self.t0, self.tf, n_elements, degree)
+        tol = real_number(tol, "tol", positive=True)
+        history: list[RefinementStep] = []
+        guess = options.pop("guess", None)
+        result = None
+        for rnd in range(int(max_rounds)):
+            result = self.solve(mesh, guess=guess, **options)
+            errors = _Transcription(self, mesh, build=False).element_errors(result)
+            emax = float(errors.max())
+            history.append(
+                RefinementStep(
+                    rnd,
+                    mesh.n_elements,
+                    mesh.n_nodes,
+                    result.objective,
+                    emax,
+                    result.iterations,
+                    result.timings["total_s"],
+                )
+            )
+            if emax <= tol:
+                break
+            counts = split_counts(errors, tol, mesh.degrees)
+            if mesh.n_elements + sum(c - 1 for c in counts) > max_elements:
+                break
+            mesh, guess = mesh.split(counts), result
+        assert result is not None
+        return dataclasses.replace(result, refinement=history)
+
+
+class _Transcription:
+    """The NLP of a problem on one mesh (CasADi symbols, bounds, index maps)."""
+
+    def __init__(self, problem: OptimalControlProblem, mesh: Mesh, build: bool = True) -> None:
+        if not isinstance(mesh, Mesh):
+            raise DefinitionError(f"mesh must be a gmuk.optimize.Mesh; got {type(mesh).__name__}")
+        if abs(mesh.t0 - problem.t0) > 1e-12 * max(1.0, abs(problem.t0)) or abs(
+            mesh.tf - problem.tf
+        ) > 1e-12 * max(1.0, abs(problem.tf)):
+            raise DefinitionError(
+                f"the mesh spans [{mesh.t0:g}, {mesh.tf:g}] s; the problem [{problem.t0:g}, "
+                f"{problem.tf:g}] s"
+            )
+        self.problem = problem
+        self.mesh = mesh
+        self.times = mesh.times
+        self.W = mesh.quadrature_weights
+        self.n_th_cols = sum(mesh.degrees)
+        if build:
+            self._build()
+
+    # layout of the decision vector: vec(Y) (n_y × N), vec(U) (n_u × N), vec(Θ) (n_th × Σp)
+    def _build(self) -> None:
+        pb, mesh = self.problem, self.mesh
+        N, K, ny, nu_, nth = mesh.n_nodes, mesh.n_elements, pb.n_y, pb.n_u, pb.n_th
+        self.n_x = (ny + nu_) * N + nth * self.n_th_cols + nth * K
+        # path constraints at nodes 1 … N−1 (the last skipped where the final state fixes
+        # the constraint's bodies: it was checked before solving)
+        self._path_nodes = [
+            np.arange(1, N - 1 if all(pb._final_fixes(p) for p in plans) else N)
+            for _, _, plans in pb._constraints
+        ]
+        self.mapped = False
+        if len(set(mesh.degrees)) == 1:
+            try:
+                self._build_mapped()
+                self.mapped = True
+            except DefinitionError:
+                self.mapped = False  # a part needs a numeric time: one expression per node
+        if not self.mapped:
+            self._build_unrolled()
+            self._check_finite()
+        # variable bounds: initial state, given final entries, θ and φ per element (φ₀ = 0)
+        lbx = np.full(self.n_x, -np.inf)
+        ubx = np.full(self.n_x, np.inf)
+        lbx[:ny] = ubx[:ny] = pb.y0
+        for r, v in pb._final_y.items():
+            lbx[(N - 1) * ny + r] = ubx[(N - 1) * ny + r] = v
+        th0 = (ny + nu_) * N
+        lbx[th0:] = -pb.max_element_rotation
+        ubx[th0:] = pb.max_element_rotation
+        phi0 = th0 + nth * self.n_th_cols
+        lbx[phi0 : phi0 + nth] = ubx[phi0 : phi0 + nth] = 0.0
+        self.lbx, self.ubx = lbx, ubx
+
+    def _path_bounds(self, c: Any, kind: str) -> tuple[float, float]:
+        if kind != "inequality":
+            return 0.0, 0.0
+        lo = next((b.value for b in c.bounds if b.side == "lower"), -np.inf)
+        hi = next((b.value for b in c.bounds if b.side == "upper"), np.inf)
+        return lo, hi
+
+    def _node_terms(self, t: Any, y: Any, u: Any, Rs: Sequence[Any]) -> tuple[Any, list[Any], Any]:
+        """F, the path-constraint values (one column per constraint) and the running cost
+        at one node, for symbolic or numeric t."""
+        pb = self.problem
+        F = pb._rhs(t, y, u, Rs)
+        values = []
+        for c, kind, plans in pb._constraints:
+            q, nu = pb._casadi_qv(plans, y, Rs)
+            if kind == "inequality":
+                values.append(parts.inequality_value(c, q, nu, t))
+            else:
+                values.append(parts.equality_residual(c, q, nu, t))
+        if pb.cost is None:
+            L = u.T @ (_dm(pb._M_inv) @ u)
+        else:
+            q, nu = pb._casadi_qv(pb._plans, y, Rs)
+            us = tuple(u[p.u : p.u + p.body.dof] for p in pb._plans)
+            L = parts._as_column(pb.cost(t, q, nu, us), "cost", 1)
+        return F, values, L
+
+    def _element(
+        self, p: int, Rbar: Any, phi: Any, Yk: Any, Uk: Any, THk: Any, tk: Sequence[Any]
+    ) -> tuple[Any, Any, Any, Any, list[Any]]:
+        """One element's expressions: start and end attitudes (3 × 3 n_rigid), the
+        collocation residuals (column), the cost (∫ L over the element) and each
+        constraint's values at nodes 1 … p (columns). ``tk`` numeric or symbolic."""
+        import casadi as ca
+
+        pb = self.problem
+        nth, nr = pb.n_th, pb.n_th // 3
+        starts = [
+            Rbar[:, 3 * b : 3 * b + 3] @ _so3.exp_casadi(phi[3 * b : 3 * b + 3]) for b in range(nr)
+        ]
+        thetas = [ca.SX.zeros(nth, 1)] + [THk[:, j] for j in range(p)]
+        node_R = [starts] + [pb._attitudes(starts, thetas[j]) for j in range(1, p + 1)]
+        Fs, Ls = [], []
+        values: list[list[Any]] = [[] for _ in pb._constraints]
+        for j in range(p + 1):
+            F, vals, L = self._node_terms(tk[j], Yk[:, j], Uk[:, j], node_R[j])
+            Fs.append(F)
+            Ls.append(L)
+            if j > 0:
+                for c_vals, v in zip(values, vals, strict=True):
+                    c_vals.append(v)
+        _x_nodes, w = lgl_nodes(p)
+        h = tk[p] - tk[0]
+        A = ca.DM(0.5 * np.asarray(lgl_integration_matrix(p))[1:].T)  # (p+1) × p
+        dyn = Yk[:, 1:] - ca.repmat(Yk[:, 0], 1, p) - h * (ca.horzcat(*Fs) @ A)
+        res = [ca.vec(dyn)]
+        if nth:
+            rates = ca.horzcat(*[pb._theta_rate(thetas[j], Yk[:, j]) for j in range(p + 1)])
+            res.append(ca.vec(THk - h * (rates @ A)))
+        cost = 0.5 * h * (ca.horzcat(*Ls) @ ca.DM(w))
+        R_start = ca.horzcat(*starts) if nr else ca.SX(3, 0)
+        R_end = ca.horzcat(*node_R[p]) if nr else ca.SX(3, 0)
+        return R_start, R_end, ca.vertcat(*res), cost, [ca.vertcat(*v) for v in values]
+
+    def _symbols(self, kind: Any) -> tuple[Any, Any, Any, Any, Any, Any, Any]:
+        """x, p and their views: Y (n_y × N), U (n_u × N), Θ (n_th × Σp), Φ (n_th × K),
+        R̄ (3 × 3 n_rigid K)."""
+        import casadi as ca
+
+        pb, mesh = self.problem, self.mesh
+        N, K, ny, nu_, nth = mesh.n_nodes, mesh.n_elements, pb.n_y, pb.n_u, pb.n_th
+        X = kind.sym("x", self.n_x)
+        P = kind.sym("p", 9 * (nth // 3) * K)
+        o1, o2, o3 = ny * N, (ny + nu_) * N, (ny + nu_) * N + nth * self.n_th_cols
+        Y = ca.reshape(X[:o1], ny, N)
+        U = ca.reshape(X[o1:o2], nu_, N)
+        TH = ca.reshape(X[o2:o3], nth, self.n_th_cols)
+        PHI = ca.reshape(X[o3:], nth, K)
+        RBAR = ca.reshape(P, 3, 3 * (nth // 3) * K)
+        return X, P, Y, U, TH, PHI, RBAR
+
+    def _build_mapped(self) -> None:
+        """One CasADi Function per element, with the node times as a symbolic input, mapped
+        over the elements: CasADi differentiates one element, not every node's copy, so the
+        cost of building the NLP hardly grows with the mesh."""
+        import casadi as ca
+
+        pb, mesh = self.problem, self.mesh
+        K, p = mesh.n_elements, mesh.degrees[0]
+        ny, nu_, nth, nr = pb.n_y, pb.n_u, pb.n_th, pb.n_th // 3
+        sym = [
+            ca.SX.sym("Rbar", 3, 3 * nr),
+            ca.SX.sym("phi", nth),
+            ca.SX.sym("y", ny, p + 1),
+            ca.SX.sym("u", nu_, p + 1),
+            ca.SX.sym("theta", nth, p),
+            ca.SX.sym("t", p + 1),
+        ]
+        R_start, R_end, res, cost, path = self._element(
+            p, sym[0], sym[1], sym[2], sym[3], sym[4], [sym[5][j] for j in range(p + 1)]
+        )
+        fn = ca.Function("element", sym, [R_start, R_end, res, cost, *path])
+        # float() or math.* on a symbol gives NaN silently (CasADi's SX.__float__): a part
+        # that needs a numeric time shows it here, at the start, and goes node by node
+        _x0, p0 = self._sample_point()
+        Ys = np.repeat(self.problem.y0[:, None], p + 1, axis=1)
+        sample = fn(
+            p0[: 9 * nr].reshape(3, -1, order="F"),
+            np.zeros(nth),
+            Ys,
+            np.zeros((nu_, p + 1)),
+            np.zeros((nth, p)),
+            self.times[: p + 1],
+        )
+        if not all(np.all(np.isfinite(np.asarray(v))) for v in sample):
+            raise DefinitionError("a part is not finite with a symbolic time")
+        X, P, Y, U, TH, PHI, RBAR = self._symbols(ca.MX)
+        idx = [k * p + j for k in range(K) for j in range(p + 1)]
+        T = ca.DM(np.asarray(self.times)[idx].reshape(K, p + 1).T)
+        out = fn.map(K)(RBAR, PHI, Y[:, idx], U[:, idx], TH, T)
+        self._assemble(
+            X, P, U, out[0], out[1], ca.vec(out[2]), out[3], [ca.vec(o) for o in out[4:]]
+        )
+
+    def _build_unrolled(self) -> None:
+        """One expression per element, each part called with the nodes' numeric times."""
+        import casadi as ca
+
+        pb, mesh = self.problem, self.mesh
+        nr = pb.n_th // 3
+        X, P, Y, U, TH, PHI, RBAR = self._symbols(ca.SX)
+        outs = []
+        col = 0
+        for k, p in enumerate(mesh.degrees):
+            i0 = mesh.first_node(k)
+            outs.append(
+                self._element(
+                    p,
+                    RBAR[:, 3 * nr * k : 3 * nr * (k + 1)],
+                    PHI[:, k],
+                    Y[:, i0 : i0 + p + 1],
+                    U[:, i0 : i0 + p + 1],
+                    TH[:, col : col + p],
+                    [float(t) for t in self.times[i0 : i0 + p + 1]],
+                )
+            )
+            col += p
+        self._assemble(
+            X,
+            P,
+            U,
+            ca.horzcat(*[o[0] for o in outs]),
+            ca.horzcat(*[o[1] for o in outs]),
+            ca.vertcat(*[o[2] for o in outs]),
+            ca.horzcat(*[o[3] for o in outs]),
+            [ca.vertcat(*[o[4][c] for o in outs]) for c in range(len(pb._constraints))],
+        )
+
+    def _assemble(
+        self,
+        X: Any,
+        P: Any,
+        U: Any,
+        R_start: Any,
+        R_end: Any,
+        dyn: Any,
+        costs: Any,
+        path: list[Any],
+    ) -> None:
+        """The NLP from the elements' outputs: collocation residuals, attitude continuity
+        between elements, path constraints (element-major: nodes 1 … N−1 in order), final
+        attitudes, and the cost."""
+        import casadi as ca
+
+        pb, K = self.problem, self.mesh.n_elements
+        nr = pb.n_th // 3
+        g_blocks = [dyn]
+        if nr and K > 1:
+            Ra, Rb = ca.SX.sym("Ra", 3, 3 * nr), ca.SX.sym("Rb", 3, 3 * nr)
+            rows = [
+                _skew_vee(Ra[:, 3 * b : 3 * b + 3].T @ Rb[:, 3 * b : 3 * b + 3]) for b in range(nr)
+            ]
+            cont = ca.Function("continuity", [Ra, Rb], [ca.vertcat(*rows)])
+            g_blocks.append(
+                ca.vec(cont.map(K - 1)(R_start[:, 3 * nr :], R_end[:, : 3 * nr * (K - 1)]))
+            )
+        n_eq = sum(b.shape[0] for b in g_blocks)
+        lbg, ubg = [0.0] * n_eq, [0.0] * n_eq
+        self.path_rows: list[tuple[Any, str, np.ndarray, int, int]] = []
+        row = n_eq
+        for (c, kind, _), nodes, values in zip(
+            pb._constraints, self._path_nodes, path, strict=True
+        ):
+            if nodes.size == 0:
+                continue
+            s = values.shape[0] // (self.mesh.n_nodes - 1)
+            block = values[: s * nodes.size]
+            lo, hi = self._path_bounds(c, kind)
+            lbg += [lo] * block.shape[0]
+            ubg += [hi] * block.shape[0]
+            g_blocks.append(block)
+            self.path_rows.append((c, kind, nodes, row, s))
+            row += block.shape[0]
+        R_last = R_end[:, R_end.shape[1] - 3 * nr :]
+        att = self._final_attitude_rows([R_last[:, 3 * b : 3 * b + 3] for b in range(nr)])
+        lbg += [0.0] * att.shape[0]
+        ubg += [0.0] * att.shape[0]
+        self.x: Any = X
+        self.p: Any = P
+        self.g = ca.vertcat(*g_blocks, att)
+        if pb.cost is None:  # quadratic in U: one expression, outside the elements
+            self.f = ca.sum2(ca.sum1(U * (_dm(pb._M_inv) @ U)) * _dm(self.W).T)
+        else:
+            self.f = ca.sum2(costs)
+        self.lbg, self.ubg = np.array(lbg), np.array(ubg)
+
+    def _sample_point(self) -> tuple[FloatArray, FloatArray]:
+        """x with the initial state at every node and zero controls and charts, and p with
+        the initial attitudes as every element's reference."""
+        pb, mesh = self.problem, self.mesh
+        x = np.zeros(self.n_x)
+        x[: pb.n_y * mesh.n_nodes] = np.tile(pb.y0, mesh.n_nodes)
+        Rbar = np.tile(np.array(pb.R0).reshape(1, -1, 3, 3), (mesh.n_elements, 1, 1, 1))
+        p = np.transpose(Rbar, (2, 0, 1, 3)).reshape(3, -1).reshape(-1, order="F")
+        return x, p
+
+    def _check_finite(self) -> None:
+        """Refuse an NLP that is not finite at the sample point, naming the part that
+        returns NaN there (a numeric method called with CasADi symbols)."""
+        import casadi as ca
+
+        x, p = self._sample_point()
+        fg = ca.Function("fg", [self.x, self.p], [self.f, self.g])
+        if all(np.all(np.isfinite(np.asarray(v))) for v in fg(x, p)):
+            return
+        pb = self.problem
+        y = ca.SX.sym("y", pb.n_y)
+        Rs = [ca.SX.sym("R", 3, 3) for _ in pb.R0]
+        args = [y, *Rs]
+        values = [np.asarray(pb.y0), *[np.asarray(R) for R in pb.R0]]
+        q, nu = pb._casadi_qv(pb._plans, y, Rs)
+        index = {p_.body.name: i for i, p_ in enumerate(pb._plans)}
+        t = float(self.times[0])
+        suspects: list[tuple[str, Any]] = []
+        for f, plans in pb._forces:
+            ids = [index[p_.body.name] for p_ in plans]
+            suspects.append(
+                (
+                    f"force model {f.name!r} ({type(f).__name__})",
+                    lambda f=f, ids=ids, plans=plans: ca.vertcat(
+                        *parts.force_terms(
+                            f,
+                            t,
+                            [q[i] for i in ids],
+                            [nu[i] for i in ids],
+                            [p_.body for p_ in plans],
+                        )
+                    ),
+                )
+            )
+        for c, kind, plans in pb._constraints:
+            ids = [index[p_.body.name] for p_ in plans]
+            fn = parts.inequality_value if kind == "inequality" else parts.equality_residual
+            suspects.append(
+                (
+                    f"constraint {c.name!r} ({type(c).__name__})",
+                    lambda c=c, fn=fn, ids=ids: fn(
+                        c, tuple(q[i] for i in ids), tuple(nu[i] for i in ids), t
+                    ),
+                )
+            )
+        for who, build in suspects:
+            value = np.asarray(ca.Function("part", args, [build()])(*values))
+            if not np.all(np.isfinite(value)):
+                raise DefinitionError(
+                    f"{who} returns NaN or inf at the initial state when evaluated with "
+                    "CasADi symbols: does its CasADi form call float(), math.* or numpy on a "
+                    "symbol (CasADi turns those into NaN silently)? Write it with casadi "
+                    "operations"
+                )
+        raise DefinitionError(
+            "the transcribed problem is not finite at the initial state (NaN or inf in the "
+            "dynamics, constraints or cost there)"
+        )
+
+    def _final_attitude_rows(self, R_final: Sequence[Any]) -> Any:
+        """vee(skew(R_fᵀ R(tf))) = 0 for every rigid body with a given final attitude."""
+        import casadi as ca
+
+        pb = self.problem
+        rows = []
+        for p in pb._plans:
+            if p.rigid and p.body.name in pb._final_R:
+                rows.append(_skew_vee(ca.DM(pb._final_R[p.body.name]).T @ R_final[p.th // 3]))
+        return ca.vertcat(*rows) if rows else ca.DM(0, 1)
+
+    # ------------------------------------------------------------------ guess
+    def initial_guess(self, guess: OptimalControlResult | None) -> tuple[FloatArray, FloatArray]:
+        """The starting point x₀ and the reference attitudes R̄ (the parameters p)."""
+        pb, mesh = self.problem, self.mesh
+        N, t = mesh.n_nodes, self.times
+        nr = pb.n_th // 3
+        s = (t - pb.t0) / (pb.tf - pb.t0)
+        if guess is not None:
+            Yg = guess.states_at(t)
+            Ug = guess.control(t)
+            Rg = guess.attitudes_at(t)
+        else:
+            yf = pb.y0.copy()
+            for r, v in pb._final_y.items():
+                yf[r] = v
+            Yg = pb.y0[None, :] + s[:, None] * (yf - pb.y0)[None, :]
+            Ug = np.zeros((N, pb.n_u))
+            rigid = [p for p in pb._plans if p.rigid]
+            Rg = np.zeros((N, len(rigid), 3, 3))
+            for j, p in enumerate(rigid):
+                R0 = pb.R0[j]
+                Rf = pb._final_R.get(p.body.name, R0)
+                phi = so3.log(R0.T @ Rf)
+                Rg[:, j] = R0 @ so3.exp(s[:, None] * phi[None, :])
+                if p.body.name in pb._final_R and not any(
+                    r in pb._final_y for r in range(p.y + 3, p.y + 6)
+                ):
+                    Yg[:, p.y + 3 : p.y + 6] = phi / (pb.tf - pb.t0)
+        if nr:
+            Rg[0] = np.array(pb.R0)  # the start is given
+        TH = np.zeros((pb.n_th, self.n_th_cols))
+        Rbar = np.zeros((mesh.n_elements, nr, 3, 3))
+        col = 0
+        for k, deg in enumerate(mesh.degrees):
+            i0 = mesh.first_node(k)
+            for b in range(nr):
+                Rbar[k, b] = _orthonormal(Rg[i0, b])
+            for j in range(1, deg + 1):
+                for b in range(nr):
+                    d = so3.log(_orthonormal(Rbar[k, b].T @ Rg[i0 + j, b]))
+                    TH[3 * b : 3 * b + 3, col + j - 1] = np.clip(
+                        d, -pb.max_element_rotation, pb.max_element_rotation
+                    )
+            col += deg
+        x0 = np.concatenate(
+            [
+                Yg.reshape(-1),
+                Ug.reshape(-1),
+                TH.reshape(-1, order="F"),
+                np.zeros(pb.n_th * mesh.n_elements),
+            ]
+        )
+        # p = vec(R̄) with R̄ (3, 3 n_rigid K): element k, body b in columns 3(n_r k + b) …
+        params = np.transpose(Rbar, (2, 0, 1, 3)).reshape(3, -1).reshape(-1, order="F")
+        return x0, params
+
+    # ------------------------------------------------------------------ solve
+    def solve(
+        self,
+        *,
+        guess: OptimalControlResult | None,
+        max_iter: int,
+        max_cpu_time: float,
+        tol: float,
+        log: bool,
+        ipopt_options: Mapping[str, Any] | None,
+        transcription_s: float,
+    ) -> OptimalControlResult:
+        import casadi as ca
+
+        if isinstance(max_iter, bool) or int(max_iter) != max_iter or max_iter < 0:
+            raise DefinitionError(f"max_iter must be an integer ≥ 0; got {max_iter!r}")
+        cpu = real_number(max_cpu_time, "max_cpu_time (s)", positive=True)
+        tol = real_number(tol, "tol", positive=True)
+        tic = time.perf_counter()
+        log_path = None
+        opts: dict[str, Any] = {
+            "print_time": False,
+            "ipopt.print_level": 0,
+            "ipopt.sb": "yes",
+            "ipopt.max_iter": int(max_iter),
+            "ipopt.max_cpu_time": cpu,
+            "ipopt.max_wall_time": cpu,
+            "ipopt.tol": tol,
+        }
+        if log:
+            fd, log_path = tempfile.mkstemp(prefix="gmuk-ipopt-", suffix=".log")
+            os.close(fd)
+            opts["ipopt.output_file"] = log_path
+            opts["ipopt.file_print_level"] = 5
+        for k, v in (ipopt_options or {}).items():
+            opts[k if k.startswith("ipopt.") else f"ipopt.{k}"] = v
+        nlp = {"x": self.x, "p": self.p, "f": self.f, "g": self.g}
+        try:
+            solver = ca.nlpsol("gmuk", "ipopt", nlp, opts)
+        except RuntimeError as exc:
+            raise DefinitionError(f"CasADi refused the IPOPT options: {exc}") from None
+        x0, pbar = self.initial_guess(guess)
+        x0 = np.clip(x0, self.lbx, self.ubx)
+        setup = time.perf_counter() - tic
+        tic = time.perf_counter()
+        out = solver(x0=x0, p=pbar, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        solve_s = time.perf_counter() - tic
+        stats = solver.stats()
+        text = None
+        if log_path is not None:
+            with open(log_path, encoding="utf-8", errors="replace") as fh:
+                text = fh.read()
+            os.unlink(log_path)
+        x = np.asarray(out["x"]).reshape(-1)
+        lam_g = np.asarray(out["lam_g"]).reshape(-1)
+        lam_x = np.asarray(out["lam_x"]).reshape(-1)
+        gval = np.asarray(out["g"]).reshape(-1)
+        viol = float(np.maximum(np.maximum(self.lbg - gval, gval - self.ubg), 0.0).max(initial=0))
+        iters = stats.get("iterations") or {}
+        history = {
+            k: np.asarray(iters.get(k, []), dtype=float) for k in ("obj", "inf_pr", "inf_du", "mu")
+        }
+        timings = {
+            "transcription_s": transcription_s + setup,
+            "solve_s": solve_s,
+            "total_s": transcription_s + setup + solve_s,
+        }
+        return self._result(
+            x, pbar, lam_g, lam_x, gval, float(out["f"]), stats, history, text, timings, viol
+        )
+
+    def _unpack(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        pb, N, K = self.problem, self.mesh.n_nodes, self.mesh.n_elements
+        ny, nu_, nth = pb.n_y, pb.n_u, pb.n_th
+        o1, o2, o3 = ny * N, (ny + nu_) * N, (ny + nu_) * N + nth * self.n_th_cols
+        Y = x[:o1].reshape(N, ny)
+        U = x[o1:o2].reshape(N, nu_)
+        TH = x[o2:o3].reshape(self.n_th_cols, nth)
+        PHI = x[o3:].reshape(K, nth)
+        return Y, U, TH, PHI
+
+    def _attitudes_numeric(
+        self, TH: FloatArray, PHI: FloatArray, pbar: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """Node attitudes (N, n_rigid, 3, 3) and element-start attitudes (K, n_rigid, 3, 3),
+        ``R̄_k exp(φ_k) exp(θ)``: products of exponentials. A node shared by two elements
+        takes the end of the earlier one (the start of the next equals it to the solver's
+        tolerance on the continuity rows)."""
+        pb, mesh = self.problem, self.mesh
+        nr, K = pb.n_th // 3, mesh.n_elements
+        Rbar = pbar.reshape(3, -1, order="F").reshape(3, K, nr, 3).transpose(1, 2, 0, 3)
+        starts = Rbar @ so3.exp(PHI.reshape(K, nr, 3))
+        R = np.zeros((mesh.n_nodes, nr, 3, 3))
+        if nr:
+            R[0] = starts[0]
+        col = 0
+        for k, p in enumerate(mesh.degrees):
+            i0 = mesh.first_node(k)
+            th = TH[col : col + p].reshape(p, nr, 3)
+            R[i0 + 1 : i0 + p + 1] = starts[k][None] @ so3.exp(th)
+            col += p
+        return R, starts
+
+    def _result(
+        self,
+        x: FloatArray,
+        pbar: FloatArray,
+        lam_g: FloatArray,
+        lam_x: FloatArray,
+        gval: FloatArray,
+        objective: float,
+        stats: Mapping[str, Any],
+        history: dict[str, FloatArray],
+        text: str | None,
+        timings: dict[str, float],
+        violation: float,
+    ) -> OptimalControlResult:
+        pb, mesh = self.problem, self.mesh
+        Y, U, TH, PHI = self._unpack(x)
+        R, starts = self._attitudes_numeric(TH, PHI, pbar)
+        paths = {}
+        for c, kind, nodes, r0, m in self.path_rows:
+            n = nodes.size
+            rows = np.arange(r0, r0 + n * m)
+            vals = gval[rows].reshape(n, m)
+            lam = lam_g[rows].reshape(n, m) / self.W[nodes][:, None]
+            paths[c.name] = PathConstraintResult(
+                name=c.name,
+                kind=kind,
+                t=self.times[nodes],
+                value=vals[:, 0] if kind == "inequality" else vals,
+                lower=float(self.lbg[rows[0]]) if kind == "inequality" else 0.0,
+                upper=float(self.ubg[rows[0]]) if kind == "inequality" else 0.0,
+                multiplier=lam[:, 0] if kind == "inequality" else lam,
+                unit=getattr(c, "unit", "") if kind == "inequality" else "",
+                cost_unit="N²·s/kg" if pb.cost is None else "cost",
+            )
+        return OptimalControlResult(
+            t=self.times.copy(),
+            mesh=mesh,
+            body_names=tuple(p.body.name for p in pb._plans),
+            body_kinds=tuple(str(p.body.kind) for p in pb._plans),
+            body_dofs=tuple(p.body.dof for p in pb._plans),
+            y=Y.copy(),
+            u=U.copy(),
+            R_NB=R,
+            theta=TH.copy(),
+            element_R=starts,
+            objective=objective,
+            status=str(stats.get("return_status", "unknown")),
+            success=bool(stats.get("success", False)),
+            iterations=int(stats.get("iter_count", 0)),
+            iteration_history=history,
+            log=text,
+            path=paths,
+            timings=timings,
+            stats={
+                "constraint_violation": violation,
+                "n_variables": int(x.size),
+                "n_constraints": int(gval.size),
+            },
+            _kkt=_KKTEvaluator(self, x, pbar, lam_g, lam_x),
+        )
+
+    # ------------------------------------------------------------------ error estimate
+    def element_errors(self, result: OptimalControlResult) -> FloatArray:
+        """Relative collocation-defect estimate of each element (see solve_adaptive)."""
+        pb, mesh = self.problem, self.mesh
+        nr = pb.n_th // 3
+        # the nodal F and θ̇, in one batch
+        R_nodes = result.R_NB
+        F_nodes = self._rhs_batch(result.t, result.y, result.u, R_nodes)
+        per_element = []
+        pts_t, pts_y, pts_u, pts_R, pts_T = [], [], [], [], []
+        col = 0
+        for k, p in enumerate(mesh.degrees):
+            i0 = mesh.first_node(k)
+            a, b = mesh.breaks[k], mesh.breaks[k + 1]
+            h = b - a
+            x_nodes, _ = lgl_nodes(p)
+            z, wz = np.polynomial.legendre.leggauss(2 * p + 1)
+            Ainteg = _integration_at(x_nodes, z)  # (m, p+1)
+            L = _interp(x_nodes, z)
+            Yk, Uk, Fk = (
+                result.y[i0 : i0 + p + 1],
+                result.u[i0 : i0 + p + 1],
+                F_nodes[i0 : i0 + p + 1],
+            )
+            th_nodes = np.zeros((p + 1, pb.n_th))
+            th_nodes[1:] = result.theta[col : col + p]
+            col += p
+            Tk = np.array([self._theta_rate_num(th_nodes[j], Yk[j]) for j in range(p + 1)])
+            Yz = Yk[0][None, :] + 0.5 * h * Ainteg @ Fk
+            Tz = 0.5 * h * Ainteg @ Tk
+            Rz = np.array(
+                [
+                    [
+                        result.element_R[k][b_] @ _so3.exp_numeric(Tz[m, 3 * b_ : 3 * b_ + 3])
+                        for b_ in range(nr)
+                    ]
+                    for m in range(z.size)
+                ]
+            ).reshape(z.size, nr, 3, 3)
+            pts_t.append(a + 0.5 * h * (z + 1.0))
+            pts_y.append(Yz)
+            pts_u.append(L @ Uk)
+            pts_R.append(Rz)
+            pts_T.append(np.array([self._theta_rate_num(Tz[m], Yz[m]) for m in range(z.size)]))
+            scale = 1.0 + np.abs(np.concatenate([Yk, th_nodes], axis=1)).max(axis=0)
+            per_element.append((h, wz, L @ Fk, L @ Tk, scale))
+        F_pts = self._rhs_batch(
+            np.concatenate(pts_t),
+            np.concatenate(pts_y),
+            np.concatenate(pts_u),
+            np.concatenate(pts_R),
+        )
+        errors = np.zeros(mesh.n_elements)
+        m0 = 0
+        for k, (h, wz, F_interp, T_interp, scale) in enumerate(per_element):
+            m = wz.size
+            d = np.concatenate([F_interp - F_pts[m0 : m0 + m], T_interp - pts_T[k]], axis=1)
+            m0 += m
+            errors[k] = float((0.5 * h * (wz @ np.abs(d)) / scale).max())
+        return errors
+
+    def _rhs_batch(self, t: FloatArray, y: FloatArray, u: FloatArray, R: FloatArray) -> FloatArray:
+        """F at many points (n, n_y): one mapped CasADi call when the parts take a symbolic
+        time, else point by point."""
+        import casadi as ca
+
+        pb = self.problem
+        n, nr = t.size, pb.n_th // 3
+        try:
+            ts, ys, us = ca.SX.sym("t"), ca.SX.sym("y", pb.n_y), ca.SX.sym("u", pb.n_u)
+            Rs = ca.SX.sym("R", 3, 3 * nr)
+            fn = ca.Function(
+                "rhs",
+                [ts, ys, us, Rs],
+                [pb._rhs(ts, ys, us, [Rs[:, 3 * b : 3 * b + 3] for b in range(nr)])],
+            )
+        except DefinitionError:
+            return np.array([self._rhs_num(float(t[i]), y[i], u[i], list(R[i])) for i in range(n)])
+        Rflat = np.transpose(R, (2, 0, 1, 3)).reshape(3, 3 * nr * n) if nr else np.zeros((3, 0))
+        out = fn.map(n)(t[None, :], y.T, u.T, Rflat)
+        return np.asarray(out).T
+
+    def _rhs_num(self, t: float, y: FloatArray, u: FloatArray, Rs: Sequence[FloatArray]) -> Any:
+        import casadi as ca
+
+        out = self.problem._rhs(t, ca.DM(y), ca.DM(u), [ca.DM(R) for R in Rs])
+        return np.asarray(ca.DM(out)).reshape(-1)
+
+    def _theta_rate_num(self, theta: FloatArray, y: FloatArray) -> FloatArray:
+        pb = self.problem
+        out = np.zeros(pb.n_th)
+        for p in pb._plans:
+            if p.rigid:
+                out[p.th : p.th + 3] = _so3.theta_rate_numeric(
+                    theta[p.th : p.th + 3], y[p.y + 3 : p.y + 6]
+                )
+        return out
+
+
+class _KKTEvaluator:
+    """The NLP's KKT residuals at the solution, computed on request (builds the gradient of
+    the Lagrangian only then)."""
+
+    def __init__(
+        self,
+        tr: _Transcription,
+        x: FloatArray,
+        p: FloatArray,
+        lam_g: FloatArray,
+        lam_x: FloatArray,
+    ) -> None:
+        self.tr, self.x, self.p, self.lam_g, self.lam_x = tr, x, p, lam_g, lam_x
+
+    def __call__(self) -> dict[str, float]:
+        import casadi as ca
+
+        tr = self.tr
+        lam = type(tr.x).sym("lam", tr.g.shape[0])
+        grad = ca.Function(
+            "grad_L", [tr.x, tr.p, lam], [ca.gradient(tr.f + ca.dot(lam, tr.g), tr.x)]
+        )
+        gL = np.asarray(grad(self.x, self.p, self.lam_g)).reshape(-1) + self.lam_x
+        grad_f = ca.Function("grad_f", [tr.x, tr.p], [ca.gradient(tr.f, tr.x)])
+        grad_f_val = np.asarray(grad_f(self.x, self.p))
+        gval = np.asarray(ca.Function("g", [tr.x, tr.p], [tr.g])(self.x, self.p)).reshape(-1)
+        primal = np.maximum(np.maximum(tr.lbg - gval, gval - tr.ubg), 0.0)
+        primal_x = np.maximum(np.maximum(tr.lbx - self.x, self.x - tr.ubx), 0.0)
+        # complementarity of the inequality rows: λ times the distance to the bound it pushes
+        comp = 0.0
+        dual = 0.0
+        for _c, kind, nodes, r0, _m in tr.path_rows:
+            if kind != "inequality":
+                continue
+            rows = np.arange(r0, r0 + nodes.size)
+            lam_i, g_i = self.lam_g[rows], gval[rows]
+            up = np.where(np.isfinite(tr.ubg[rows]), tr.ubg[rows] - g_i, np.inf)
+            lo = np.where(np.isfinite(tr.lbg[rows]), g_i - tr.lbg[rows], np.inf)
+            dist = np.where(lam_i > 0, up, lo)
+            dist = np.where(np.isfinite(dist), dist, 0.0)
+            comp = max(comp, float(np.abs(lam_i * dist).max(initial=0.0)))
+            # a multiplier pushing from a side with no bound is dual-infeasible
+            wrong = np.where(lam_i > 0, ~np.isfinite(tr.ubg[rows]), ~np.isfinite(tr.lbg[rows]))
+            dual = max(dual, float(np.abs(lam_i[wrong]).max(initial=0.0)))
+        return {
+            "stationarity": float(np.abs(gL).max(initial=0.0)),
+            "stationarity_relative": float(
+                np.abs(gL).max(initial=0.0) / max(1.0, float(np.abs(grad_f_val).max(initial=0.0)))
+            ),
+            "primal_violation": float(max(primal.max(initial=0.0), primal_x.max(initial=0.0))),
+            "complementarity": comp,
+            "dual_violation": dual,
+        }
+
+
+def _skew_vee(E: Any) -> Any:
+    """vee of the skew part of a 3 × 3 CasADi matrix: sin(angle) times the axis of a
+    rotation E, zero iff E = I (or a half turn)."""
+    import casadi as ca
+
+    return 0.5 * ca.vertcat(E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1])
+
+
+def _dm(a: FloatArray) -> Any:
+    import casadi as ca
+
+    return ca.DM(a)
+
+
+def _orthonormal(R: FloatArray) -> FloatArray:
+    """The nearest rotation (a product of rotations drifts by rounding only)."""
+    u, _, vt = np.linalg.svd(R)
+    out: FloatArray = u @ vt
+    if np.linalg.det(out) < 0:
+        u[:, -1] *= -1
+        out = u @ vt
+    return out
+
+
+def _interp(x: FloatArray, y: FloatArray) -> FloatArray:
+    from gmuk.optimize.lgl import interpolation_matrix
+
+    return interpolation_matrix(x, y)
+
+
+def _integration_at(x: FloatArray, y: FloatArray) -> FloatArray:
+    """B (len(y), len(x)): ``B_mj = ∫_{−1}^{y_m} ℓ_j``, ℓ_j the Lagrange basis of nodes x,
+    by exact integration of the interpolant in the Legendre basis (Vandermonde solve;
+    used only for the error estimate, at modest degree)."""
+    n = x.size
+    V = np.polynomial.legendre.legvander(x, n - 1)  # (n, n)
+    coef = np.linalg.solve(V, np.eye(n))  # Legendre coefficients of each ℓ_j (column j)
+    out = np.zeros((y.size, n))
+    for j in range(n):
+        integ = np.polynomial.legendre.legint(coef[:, j], lbnd=-1.0)
+        out[:, j] = np.polynomial.legendre.legval(y, integ)
+    return out
