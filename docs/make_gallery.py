@@ -148,6 +148,20 @@ COMMANDS: dict[str, tuple[str, str, list[tuple[str, str]], str]] = {
         ],
         "scenarios/chapter6",
     ),
+    "smd-compare": (
+        "",
+        "Figures 6.20–6.27",
+        [
+            (
+                "smd-bi/position",
+                "Bounded SMD (1 m ≤ x ≤ 2 m): UK with slack beside the direct optimum.",
+            ),
+            ("smd-bi/control", "Control acceleration of both answers."),
+            ("smd-bi/multipliers", "Multipliers of the bounds."),
+            ("smd-bi/kkt", "KKT conditions of both answers."),
+        ],
+        "scenarios/smd_compare",
+    ),
     "maintenance": (
         "",
         "Figures 6.28–6.34",
