@@ -106,8 +106,7 @@ class Campaign:
                 model.parameter(name)
                 if name in seen:
                     raise DefinitionError(
-                        f"parameter {name!r} is given in both {seen[name]} and {role}; give it "
-                        "once"
+                        f"parameter {name!r} is given in both {seen[name]} and {role}; give it once"
                     )
                 seen[name] = role
         for name, d in disp.items():
@@ -124,8 +123,10 @@ class Campaign:
                 f"runs must be an integer ≥ 1 (the default is the grid's size, without a grid "
                 f"give it); got {self.runs!r}"
             )
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or (
-            self.seed < 0
+        if (
+            isinstance(self.seed, bool)
+            or not isinstance(self.seed, (int, np.integer))
+            or (self.seed < 0)
         ):
             raise DefinitionError(f"seed must be an integer ≥ 0; got {self.seed!r}")
         set_(self, "runs", int(runs))
@@ -135,6 +136,12 @@ class Campaign:
         set_(self, "grid", grid)
         set_(self, "save_trajectories", bool(self.save_trajectories))
         set_(self, "_points", points)
+
+    @property
+    def n_runs(self) -> int:
+        """Number of runs (``runs`` after construction)."""
+        assert self.runs is not None
+        return self.runs
 
     @property
     def campaign_model(self) -> CampaignModel:
@@ -161,7 +168,7 @@ class Campaign:
     def parameters(self, k: int) -> dict[str, Any]:
         """Every parameter's value in run ``k`` (0 ≤ k < runs): nominal, fixed, grid point,
         then the dispersed values drawn from (seed, k) alone."""
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < self.runs:
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < self.n_runs:
             raise DefinitionError(f"run index must be an integer in [0, {self.runs}); got {k!r}")
         model = self.campaign_model
         values = {p.name: p.default for p in model.parameters}
@@ -169,7 +176,7 @@ class Campaign:
         values |= self.fixed
         if self.grid:
             point = int(k) % self._points
-            for name, choices in reversed(self.grid.items()):
+            for name, choices in reversed(list(self.grid.items())):
                 point, i = divmod(point, len(choices))
                 values[name] = choices[i]
         for name, d in self.dispersions.items():
@@ -205,9 +212,7 @@ class Campaign:
                 runs=data["runs"],
                 seed=data["seed"],
                 dispersions={k: dispersion_from_dict(v) for k, v in data["dispersions"].items()},
-                fixed={
-                    k: tuple(v) if isinstance(v, list) else v for k, v in data["fixed"].items()
-                },
+                fixed={k: tuple(v) if isinstance(v, list) else v for k, v in data["fixed"].items()},
                 grid={
                     k: [tuple(v) if isinstance(v, list) else v for v in vals]
                     for k, vals in data["grid"].items()
@@ -228,6 +233,7 @@ class Campaign:
         workers: int = 1,
         scheduler: Any = None,
         progress: bool | None = None,
+        connect_timeout_s: float = CONNECT_TIMEOUT_S,
     ) -> CampaignReport:
         """Run the campaign, storing each run's record in ``out`` as it finishes.
 
@@ -245,6 +251,8 @@ class Campaign:
             ``distributed.Client`` or a cluster object (e.g. ``LocalCluster``).
         progress : bool, optional
             Show a progress bar (tqdm): True, False, or None (default) on a terminal only.
+        connect_timeout_s : float
+            How long to wait for a scheduler address to answer (s).
 
         Returns
         -------
@@ -262,7 +270,7 @@ class Campaign:
         processes finish and are recorded (a second signal abandons them), a serial run in
         progress stops at its next step and is not recorded. Continue with :func:`resume`.
         """
-        backend = _backend(workers, scheduler)
+        backend = _backend(workers, scheduler, connect_timeout_s)
         st = _store.ResultStore(out)
         try:
             st.create(_manifest(self))
@@ -273,7 +281,12 @@ class Campaign:
 
 
 def resume(
-    out: str | Path, *, workers: int = 1, scheduler: Any = None, progress: bool | None = None
+    out: str | Path,
+    *,
+    workers: int = 1,
+    scheduler: Any = None,
+    progress: bool | None = None,
+    connect_timeout_s: float = CONNECT_TIMEOUT_S,
 ) -> CampaignReport:
     """Continue the campaign in ``out``: run only those of its runs with no record.
 
@@ -282,7 +295,7 @@ def resume(
     """
     st = _store.ResultStore(out)
     campaign = Campaign.from_dict(st.manifest()["campaign"])
-    backend = _backend(workers, scheduler)
+    backend = _backend(workers, scheduler, connect_timeout_s)
     return _drive(campaign, st, backend, progress)
 
 
@@ -436,7 +449,7 @@ class _Processes(_Backend):
 class _Dask(_Backend):
     name = "dask"
 
-    def __init__(self, scheduler: Any, workers: int) -> None:
+    def __init__(self, scheduler: Any, workers: int, timeout: float) -> None:
         try:
             import distributed
         except ImportError:
@@ -464,11 +477,11 @@ class _Dask(_Backend):
                     f"'local'; got {scheduler!r}"
                 )
             try:
-                self.client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+                self.client = distributed.Client(scheduler, timeout=timeout)
             except (OSError, TimeoutError, ValueError) as exc:
                 raise GmukError(
-                    f"cannot reach the Dask scheduler at {scheduler} within "
-                    f"{CONNECT_TIMEOUT_S:g} s: {type(exc).__name__}: {exc}"
+                    f"cannot reach the Dask scheduler at {scheduler} within {timeout:g} s: "
+                    f"{type(exc).__name__}: {exc}"
                 ) from None
         else:  # a cluster object (LocalCluster, …)
             if not hasattr(scheduler, "scheduler_address"):
@@ -480,8 +493,14 @@ class _Dask(_Backend):
         self.slots = max(1, sum(self.client.nthreads().values()))
 
     def submit(self, campaign: Campaign, k: int, out: str) -> Any:
-        return self.client.submit(execute, campaign, k, out, pure=False, key=f"gmuk-run-{k}-"
-                                  f"{os.getpid()}-{time.monotonic_ns()}")
+        return self.client.submit(
+            execute,
+            campaign,
+            k,
+            out,
+            pure=False,
+            key=f"gmuk-run-{k}-{os.getpid()}-{time.monotonic_ns()}",
+        )
 
     def wait(self, futures: set[Any], timeout: float) -> set[Any]:
         end = time.monotonic() + timeout
@@ -506,11 +525,13 @@ class _Dask(_Backend):
             self.cluster.close()
 
 
-def _backend(workers: Any, scheduler: Any) -> _Backend:
+def _backend(workers: Any, scheduler: Any, timeout: float = CONNECT_TIMEOUT_S) -> _Backend:
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
         raise GmukError(f"workers must be an integer ≥ 1; got {workers!r}")
+    if not (isinstance(timeout, (int, float)) and 0 < timeout < math.inf):
+        raise GmukError(f"connect_timeout_s must be a finite number > 0; got {timeout!r}")
     if scheduler is not None:
-        return _Dask(scheduler, int(workers))
+        return _Dask(scheduler, int(workers), float(timeout))
     return _Processes(int(workers)) if workers > 1 else _Backend()
 
 
@@ -595,10 +616,10 @@ def _drive(
     try:
         st.compact()
         done = st.finished()
-        todo = [k for k in range(campaign.runs) if k not in done]
+        todo = [k for k in range(campaign.n_runs) if k not in done]
         show = sys.stderr.isatty() if progress is None else bool(progress)
         bar = tqdm(
-            total=campaign.runs,
+            total=campaign.n_runs,
             initial=len(done),
             disable=not show,
             desc=f"campaign {campaign.campaign_model.name}",
@@ -664,7 +685,7 @@ def _drive(
     statuses = table.column("status").to_pylist()
     return CampaignReport(
         out=st.out,
-        runs=campaign.runs,
+        runs=campaign.n_runs,
         finished=len(statuses),
         failed=sum(s == "failed" for s in statuses),
         computed=computed,

@@ -170,7 +170,9 @@ class Choice(Dispersion):
         try:
             values = tuple(self.values)
         except TypeError:
-            raise DefinitionError(f"Choice: values must be a sequence; got {self.values!r}") from None
+            raise DefinitionError(
+                f"Choice: values must be a sequence; got {self.values!r}"
+            ) from None
         if not values:
             raise DefinitionError("Choice: values must not be empty")
         if all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):

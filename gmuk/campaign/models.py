@@ -300,11 +300,10 @@ def _settling_time(t: np.ndarray, err: np.ndarray, fraction: float = 0.02) -> fl
 _ERRORS = (
     Parameter("attitude_error", "rotation", (0.0, 0.0, 0.0), "initial attitude error θn̂ (rad)"),
     Parameter("position_error_m", "vector3", (0.0, 0.0, 0.0), "initial position error (m, N)"),
+    Parameter("velocity_error_m_s", "vector3", (0.0, 0.0, 0.0), "initial velocity error (m/s, N)"),
     Parameter(
-        "velocity_error_m_s", "vector3", (0.0, 0.0, 0.0), "initial velocity error (m/s, N)"
+        "mass_scale", "real", 1.0, "factor on the LM's mass and inertia", low=0.0, low_open=True
     ),
-    Parameter("mass_scale", "real", 1.0, "factor on the LM's mass and inertia", low=0.0,
-              low_open=True),
     Parameter(
         "inertia_scale",
         "scale3",
@@ -321,8 +320,15 @@ _ERRORS = (
         low=0.0,
     ),
     Parameter("baumgarte_zeta", "real", 1.0, "Baumgarte damping ratio ζ", low=0.0),
-    Parameter("orbits", "real", 0.01, "duration, in periods of the FCEI orbit", low=0.0,
-              low_open=True, high=1e3),
+    Parameter(
+        "orbits",
+        "real",
+        0.01,
+        "duration, in periods of the FCEI orbit",
+        low=0.0,
+        low_open=True,
+        high=1e3,
+    ),
     Parameter("samples", "integer", 201, "output times per run", low=2, high=1e6),
     Parameter("rtol", "real", 1e-12, "integrator rtol", low=0.0, low_open=True),
     Parameter("atol", "real", 1e-9, "integrator atol", low=0.0, low_open=True),
@@ -343,7 +349,7 @@ def _default_fcei_dispersions() -> dict[str, Dispersion]:
 class _LVLHModel(CampaignModel):
     """Shared set-up of the Chapter 4 adapters."""
 
-    parameters = _ERRORS
+    parameters: tuple[Parameter, ...] = _ERRORS
     headline = ("final_position_error_m", "final_attitude_error_rad")
 
     @property
@@ -416,7 +422,7 @@ class UCEIModel(_LVLHModel):
 
     name = "ucei"
     description = "UCEI virtual-spacecraft pair with Baumgarte stabilisation, dispersed start"
-    parameters = (
+    parameters: tuple[Parameter, ...] = (
         *_ERRORS,
         Parameter("roll_rate_error_rad_s", "real", 0.0, "spacecraft's initial ω₁ − virtual's"),
     )
@@ -440,7 +446,9 @@ class UCEIModel(_LVLHModel):
         )
         V_sc = V0.copy()
         V_sc[0] += params["roll_rate_error_rad_s"]
-        state = system.state(g={"virtual": g0, "spacecraft": g0}, V={"virtual": V0, "spacecraft": V_sc})
+        state = system.state(
+            g={"virtual": g0, "spacecraft": g0}, V={"virtual": V0, "spacecraft": V_sc}
+        )
         traj = system.simulate(state, (0.0, float(t[-1])), **options)
         rel = common.relative_pose(traj)
         metrics = self._tracking_metrics(traj, orbit, "virtual")
@@ -485,8 +493,15 @@ class Apollo16Model(CampaignModel):
     description = "Ch. 3 orbit at a GRAIL degree vs the uniform field (degree sweep)"
     parameters = (
         Parameter("degree", "integer", 150, "GRGM660PRIM degree (correct model)", 0, 150),
-        Parameter("orbits", "real", 1.0, "duration, in periods of the initial orbit", 0.0,
-                  1e3, low_open=True),
+        Parameter(
+            "orbits",
+            "real",
+            1.0,
+            "duration, in periods of the initial orbit",
+            0.0,
+            1e3,
+            low_open=True,
+        ),
         Parameter("samples", "integer", 361, "output times per run", 2, 1e6),
         Parameter("rtol", "real", 1e-11, "integrator rtol = atol", 0.0, low_open=True),
     )
@@ -516,9 +531,7 @@ class Apollo16Model(CampaignModel):
             "final_position_difference_m": float(dr[-1]),
             "final_along_track_difference_m": float(rsw[-1, 1]),
             "max_radial_difference_m": float(np.abs(rsw[:, 0]).max()),
-            "max_velocity_difference_m_s": float(
-                np.linalg.norm(d["velocity_m_s"], axis=1).max()
-            ),
+            "max_velocity_difference_m_s": float(np.linalg.norm(d["velocity_m_s"], axis=1).max()),
             "max_attitude_difference_rad": float(att.max()),
             "max_angular_velocity_difference_rad_s": float(
                 np.linalg.norm(d["omega_rad_s"], axis=1).max()
@@ -551,9 +564,13 @@ def get_model(name: str) -> CampaignModel:
     from gmuk import scenarios
 
     known = {s.name for s, _ in scenarios.available()}
-    why = "has no campaign support" if key in known else "is not a scenario"
+    why = (
+        f"scenario {name!r} has no campaign support"
+        if key in known
+        else f"unknown scenario {name!r}"
+    )
     raise DefinitionError(
-        f"scenario {name!r} {why}; campaigns support: {', '.join(MODELS)} (or give a function: "
+        f"{why}; campaigns support: {', '.join(MODELS)} (or give a function: "
         "gmuk.campaign.Campaign.from_function)"
     )
 

@@ -46,8 +46,7 @@ def _pyarrow() -> Any:
         import pyarrow.parquet as pq
     except ImportError:  # pragma: no cover - exercised only without the extra
         raise GmukError(
-            "campaign results are stored with pyarrow; install it with "
-            "pip install 'gmuk[campaign]'"
+            "campaign results are stored with pyarrow; install it with pip install 'gmuk[campaign]'"
         ) from None
     return pa, pq
 

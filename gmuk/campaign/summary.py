@@ -122,7 +122,10 @@ def summarize(
     if figures and ok.any():
         model = campaign.campaign_model
         headline = [f"m_{h}" for h in model.headline if f"m_{h}" in metric_cols]
-        shown = [*headline, *(c for c in metric_cols if c not in headline and c not in _BOOKKEEPING)]
+        shown = [
+            *headline,
+            *(c for c in metric_cols if c not in headline and c not in _BOOKKEEPING),
+        ]
         files += _histograms(table, shown[:12], ok, folder, formats, model.name)
         xs = []
         for name in campaign.varied():
@@ -133,7 +136,7 @@ def summarize(
         if xs and headline:
             files += _scatter(table, xs, headline, ok, folder, formats, model.name)
     return CampaignSummary(
-        runs=campaign.runs,
+        runs=campaign.n_runs,
         finished=len(statuses),
         failed=sum(s == "failed" for s in statuses),
         statistics=statistics,
@@ -156,7 +159,7 @@ def _histograms(
     plt = _pyplot()
     rows, ncols = _grid(len(cols))
     fig, axes = plt.subplots(rows, ncols, figsize=(3.2 * ncols, 2.4 * rows), squeeze=False)
-    for ax, c in zip(axes.flat, cols):
+    for ax, c in zip(axes.flat, cols, strict=False):
         y = _column(table, c)[ok]
         y = y[np.isfinite(y)]
         if _log_scale(y):
