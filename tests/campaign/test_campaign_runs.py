@@ -144,8 +144,10 @@ def oscillator(params):
 def test_user_function_returning_a_run_setup_saves_trajectories_and_resumes(tmp_path):
     campaign = Campaign.from_function(
         oscillator,
-        {"k": Parameter("k", "real", 4.0, "stiffness (N/m)", low=0.0, low_open=True),
-         "r0": (1.0, 0.0, 0.0)},
+        {
+            "k": Parameter("k", "real", 4.0, "stiffness (N/m)", low=0.0, low_open=True),
+            "r0": (1.0, 0.0, 0.0),
+        },
         runs=4,
         seed=3,
         dispersions={"r0": UniformBall(2.0)},
@@ -162,7 +164,8 @@ def test_user_function_returning_a_run_setup_saves_trajectories_and_resumes(tmp_
         r0 = np.array([r["p_r0_1"], r["p_r0_2"], r["p_r0_3"]])
         assert np.array_equal(traj.x[0, :3], r0)
         # x(1) = r0 cos(2·1): the record's metric is the saved trajectory's
-        assert r["m_final_distance_m"] == pytest.approx(np.linalg.norm(r0) * abs(math.cos(2.0)), rel=1e-8)
+        expected = np.linalg.norm(r0) * abs(math.cos(2.0))
+        assert r["m_final_distance_m"] == pytest.approx(expected, rel=1e-8)
     summary = summarize(out)
     assert summary.statistics["final_distance_m"]["count"] == 4
     assert {p.name for p in summary.files} == {"metrics.csv", "histograms.png", "scatter.png"}
@@ -199,7 +202,7 @@ def test_resume_runs_only_the_missing_runs_and_a_crash_mid_compaction_is_harmles
 def test_a_folder_holding_a_campaign_is_refused_before_any_run(tmp_path):
     campaign = Campaign("fcei", runs=2, fixed=TINY)
     campaign.run(tmp_path / "c")
-    with pytest.raises(GmukError, match="already holds a campaign.*--resume"):
+    with pytest.raises(GmukError, match=r"already holds a campaign.*--resume"):
         campaign.run(tmp_path / "c")
     with pytest.raises(GmukError, match="no campaign to resume"):
         resume(tmp_path / "empty")
@@ -207,7 +210,7 @@ def test_a_folder_holding_a_campaign_is_refused_before_any_run(tmp_path):
 
 def test_unreachable_scheduler_is_a_gmuk_error_before_any_run(tmp_path):
     campaign = Campaign("fcei", runs=2, fixed=TINY)
-    with pytest.raises(GmukError, match="cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
+    with pytest.raises(GmukError, match=r"cannot reach the Dask scheduler at tcp://127\.0\.0\.1:9"):
         campaign.run(tmp_path / "c", scheduler="tcp://127.0.0.1:9", connect_timeout_s=0.5)
     assert not (tmp_path / "c").exists()
     with pytest.raises(GmukError, match="workers must be an integer ≥ 1"):
