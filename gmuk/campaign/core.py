@@ -246,9 +246,12 @@ class Campaign:
             1: serial, in this process (for debugging); > 1: that many local worker
             processes; with ``scheduler="local"``, a Dask ``LocalCluster`` of that many
             single-threaded worker processes.
-        scheduler : str, distributed.Client or cluster, optional
+        scheduler : str, distributed.Client, cluster or Executor, optional
             A Dask scheduler's address (``"tcp://host:8786"``), ``"local"``, a
-            ``distributed.Client`` or a cluster object (e.g. ``LocalCluster``).
+            ``distributed.Client`` or a cluster object (e.g. ``LocalCluster``); or a
+            ``concurrent.futures.Executor`` of processes (``workers`` then says how many runs
+            to keep queued on it, ≈ its number of workers). Clients and executors given here
+            are left open.
         progress : bool, optional
             Show a progress bar (tqdm): True, False, or None (default) on a terminal only.
         connect_timeout_s : float
@@ -408,12 +411,13 @@ class _Backend:
 class _Processes(_Backend):
     name = "processes"
 
-    def __init__(self, workers: int) -> None:
+    def __init__(self, workers: int, pool: Any = None) -> None:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
         self.slots = workers
-        self.pool = ProcessPoolExecutor(
+        self.own = pool is None
+        self.pool = pool or ProcessPoolExecutor(
             workers, mp_context=multiprocessing.get_context("spawn"), initializer=_ignore_sigint
         )
 
@@ -437,13 +441,16 @@ class _Processes(_Backend):
         return set(done)
 
     def abandon(self) -> None:
+        if not self.own:
+            return
         # The runs in progress are dropped: end the worker processes (this pool's own).
         for p in list(getattr(self.pool, "_processes", {}).values()):
             p.terminate()
         self.pool.shutdown(wait=False, cancel_futures=True)
 
     def close(self) -> None:
-        self.pool.shutdown(wait=True, cancel_futures=True)
+        if self.own:
+            self.pool.shutdown(wait=True, cancel_futures=True)
 
 
 class _Dask(_Backend):
@@ -503,12 +510,13 @@ class _Dask(_Backend):
         )
 
     def wait(self, futures: set[Any], timeout: float) -> set[Any]:
-        end = time.monotonic() + timeout
-        while True:
-            done = {f for f in futures if f.done()}
-            if done or time.monotonic() >= end:
-                return done
-            time.sleep(0.005)
+        import distributed
+
+        try:
+            distributed.wait(list(futures), timeout=timeout, return_when="FIRST_COMPLETED")
+        except TimeoutError:  # none finished within the timeout (the caller checks signals)
+            pass
+        return {f for f in futures if f.done()}
 
     def cancel(self, futures: set[Any]) -> None:
         pending = [f for f in futures if f.status == "pending"]
@@ -530,6 +538,10 @@ def _backend(workers: Any, scheduler: Any, timeout: float = CONNECT_TIMEOUT_S) -
         raise GmukError(f"workers must be an integer ≥ 1; got {workers!r}")
     if not (isinstance(timeout, (int, float)) and 0 < timeout < math.inf):
         raise GmukError(f"connect_timeout_s must be a finite number > 0; got {timeout!r}")
+    from concurrent.futures import Executor
+
+    if isinstance(scheduler, Executor):
+        return _Processes(int(workers), scheduler)
     if scheduler is not None:
         return _Dask(scheduler, int(workers), float(timeout))
     return _Processes(int(workers)) if workers > 1 else _Backend()
@@ -600,10 +612,6 @@ def _signals(stop: _Stop) -> Iterator[None]:
             signal.signal(sig, handler)
 
 
-#: Compact the part files into runs.parquet after this many parts.
-COMPACT_EVERY = 200
-
-
 def _drive(
     campaign: Campaign, st: _store.ResultStore, backend: _Backend, progress: bool | None
 ) -> CampaignReport:
@@ -627,17 +635,13 @@ def _drive(
         )
         stop = _Stop()
         computed = 0
-        parts = 0
 
         def store(records: list[dict[str, Any]]) -> None:
-            nonlocal computed, parts
+            nonlocal computed
             kept = [r for r in records if r["status"] != "interrupted"]
             st.append(kept)
             computed += len(kept)
-            parts += 1
             bar.update(len(kept))
-            if parts % COMPACT_EVERY == 0:
-                st.compact()
 
         with _signals(stop):
             if backend.name == "serial":

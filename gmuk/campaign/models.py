@@ -316,7 +316,7 @@ _ERRORS = (
         "baumgarte_omega_n",
         "real",
         0.05,
-        "Baumgarte natural frequency ω_n (rad/s): α = 2ζω_n, β = ω_n²",
+        "Baumgarte natural frequency ω_n (rad/s): α = 2ζω_n, β = ω_n²; 0: none",
         low=0.0,
     ),
     Parameter("baumgarte_zeta", "real", 1.0, "Baumgarte damping ratio ζ", low=0.0),
@@ -364,7 +364,8 @@ class _LVLHModel(CampaignModel):
         orbit = fcei_orbit(common.MU)
         ref = LVLHReference(orbit)
         omega, zeta = p["baumgarte_omega_n"], p["baumgarte_zeta"]
-        gains = gmuk.Baumgarte(alpha=2.0 * zeta * omega, beta=omega**2)
+        # ω_n = 0: no stabilisation terms at all (the thesis's FCEI/UCEI, faster)
+        gains = None if omega == 0 else gmuk.Baumgarte(alpha=2.0 * zeta * omega, beta=omega**2)
         mass = common.LM_MASS * p["mass_scale"]
         J = scaled_inertia(common.LM_INERTIA, p["inertia_scale"], p["mass_scale"])
         r0 = ref.evaluate(0.0)
@@ -439,7 +440,10 @@ class UCEIModel(_LVLHModel):
             [
                 gmuk.ConfigurationTracking(virtual, ref, baumgarte=gains),
                 gmuk.RelativeConstraint(
-                    sc, virtual, free_axes=[0], baumgarte=gmuk.Baumgarte(alpha=gains.alpha)
+                    sc,
+                    virtual,
+                    free_axes=[0],
+                    baumgarte=None if gains is None else gmuk.Baumgarte(alpha=gains.alpha),
                 ),
             ],
             [gmuk.GravityGradient(orbit.mu)],
@@ -467,32 +471,50 @@ class UCEIModel(_LVLHModel):
         return traj, {**metrics, **_basic_metrics(traj)}
 
 
-@functools.lru_cache(maxsize=8)
-def _apollo16_uniform(orbits: float, samples: int, rtol: float) -> tuple[Trajectory, Any]:
-    """The uniform-field run of the Chapter 3 orbit (one per process and settings)."""
+def _apollo16_run(degree: int, orbits: float, samples: int, rtol: float) -> tuple[Trajectory, Any]:
+    """The Chapter 3 orbit in the uniform field (``degree`` < 0) or GRGM660PRIM truncated at
+    ``degree`` (gmuk's correct model); also returns the field's Moon and the times."""
     import gmuk
+    from gmuk.forces import SphericalHarmonicGravity
     from gmuk.scenarios import apollo16
 
-    sh, _, _ = apollo16.load_field(apollo16.DEFAULT_FIELD, (0,))
+    sh, _, _ = apollo16.load_field(apollo16.DEFAULT_FIELD, (max(degree, 0),))
     moon = gmuk.CelestialBody.moon(field=sh)
     g0, V0, period = apollo16.initial_state("elements", moon.mu, moon.radius)
     t = np.linspace(0.0, orbits * period, samples)
-    traj = apollo16._simulate(gmuk.GravityGradient(moon.mu), g0, V0, t, rtol)
-    return traj, (moon, g0, V0, t)
+    force: gmuk.ForceModel = (
+        gmuk.GravityGradient(moon.mu) if degree < 0 else SphericalHarmonicGravity(moon, degree)
+    )
+    return apollo16._simulate(force, g0, V0, t, rtol), t
+
+
+#: The comparison run of each process, by (degree, orbits, samples, rtol): computed once.
+_apollo16_reference = functools.lru_cache(maxsize=8)(_apollo16_run)
 
 
 class Apollo16Model(CampaignModel):
-    """The Chapter 3 orbit at one GRAIL degree, against the uniform field (module docstring).
+    """The Chapter 3 orbit at one GRAIL degree against a reference run (module docstring).
 
-    Metrics are differences from the uniform-field run with the same settings: position (m,
-    N) — maximum, final and its along-track part at the end (RSW of the uniform run) —,
-    velocity (m/s), attitude (rad: angle of R_uniformᵀ R) and body rate (rad/s).
+    The reference is the uniform-field run (``reference_degree = -1``, default: the thesis's
+    Figures 3.1–3.4) or the run at ``reference_degree`` (e.g. 150: the truncation error of
+    each degree), with the same duration, output times and tolerance; each worker process
+    computes it once. Metrics are the differences run − reference: position (m, N) — maximum,
+    final, its largest radial part and its along-track part at the end (RSW of the
+    reference) —, velocity (m/s), attitude (rad: angle of R_refᵀ R) and body rate (rad/s).
     """
 
     name = "apollo16"
     description = "Ch. 3 orbit at a GRAIL degree vs the uniform field (degree sweep)"
     parameters = (
         Parameter("degree", "integer", 150, "GRGM660PRIM degree (correct model)", 0, 150),
+        Parameter(
+            "reference_degree",
+            "integer",
+            -1,
+            "degree of the comparison run; -1: the uniform field",
+            -1,
+            150,
+        ),
         Parameter(
             "orbits",
             "real",
@@ -512,20 +534,17 @@ class Apollo16Model(CampaignModel):
         return {"degree": tuple(range(2, 151))}
 
     def run(self, params: Mapping[str, Any]) -> tuple[Trajectory | None, dict[str, float]]:
-        from gmuk.forces import SphericalHarmonicGravity
         from gmuk.lie import so3
         from gmuk.scenarios import apollo16
 
-        uniform, (moon, g0, V0, t) = _apollo16_uniform(
-            params["orbits"], params["samples"], params["rtol"]
-        )
-        force = SphericalHarmonicGravity(moon, params["degree"])
-        traj = apollo16._simulate(force, g0, V0, t, params["rtol"])
-        d = apollo16.differences(traj, uniform)
-        a, b = traj.body(apollo16.BODY), uniform.body(apollo16.BODY)
+        settings = (params["orbits"], params["samples"], params["rtol"])
+        reference, _ = _apollo16_reference(params["reference_degree"], *settings)
+        traj, _ = _apollo16_run(params["degree"], *settings)
+        d = apollo16.differences(traj, reference)
+        a, b = traj.body(apollo16.BODY), reference.body(apollo16.BODY)
         att = np.linalg.norm(so3.log(np.swapaxes(b.R, 1, 2) @ a.R), axis=1)
         dr = np.linalg.norm(d["position_m"], axis=1)
-        rsw = apollo16.rsw(uniform, d["position_m"])
+        rsw = apollo16.rsw(reference, d["position_m"])
         metrics = {
             "max_position_difference_m": float(dr.max()),
             "final_position_difference_m": float(dr[-1]),

@@ -183,6 +183,7 @@ def test_resume_runs_only_the_missing_runs_and_a_crash_mid_compaction_is_harmles
     first = [r for r in read_table(tmp_path / "full").to_pylist() if r["run"] < 4]
     st.append(first[:2])
     st.append(first[2:])
+    st.close()
     import shutil
 
     table = read_table(out)
@@ -195,7 +196,7 @@ def test_resume_runs_only_the_missing_runs_and_a_crash_mid_compaction_is_harmles
     starts = [k for what, k in st.attempts() if what == "start"]
     assert sorted(starts) == [4, 5, 6, 7]  # none of 0–3 computed again
     assert all(same(x, y) for x, y in zip(rows(out), rows(tmp_path / "full"), strict=True))
-    assert not list((out / "parts").glob("*.parquet"))  # compacted at the end
+    assert not list((out / "parts").glob("journal-*"))  # compacted at the end
     shutil.rmtree(out)
 
 
@@ -231,3 +232,29 @@ def test_gravity_degree_sweep_of_the_chapter3_orbit(tmp_path):
     for degree in (2, 10):
         assert by_degree[degree]["m_max_position_difference_m"] > 1.0
         assert by_degree[degree]["m_max_attitude_difference_rad"] > 1e-7
+
+
+def test_a_journal_cut_short_by_a_kill_keeps_its_complete_chunks(tmp_path):
+    """A SIGKILL while a chunk is being appended leaves its first bytes: the reader keeps
+    every complete chunk before it and ignores the tail."""
+    campaign = Campaign("fcei", runs=3, seed=4, fixed=TINY)
+    campaign.run(tmp_path / "full")
+    records = read_table(tmp_path / "full").to_pylist()
+    out = tmp_path / "c"
+    st = ResultStore(out)
+    st.create(json.loads((tmp_path / "full" / "manifest.json").read_text()))
+    st.append([records[0]])
+    st.append([records[1]])
+    (journal,) = (out / "parts").glob("journal-*.arrows")
+    two = journal.stat().st_size  # flushed: the two chunks are in the file
+    st.append([records[2]])
+    st.close()
+    data = journal.read_bytes()
+    assert read_table(out).column("run").to_pylist() == [0, 1, 2]
+    for cut in (two + 1, two + 8, two + 9, (two + len(data)) // 2, len(data) - 1):
+        journal.write_bytes(data[:cut])
+        assert read_table(out).column("run").to_pylist() == [0, 1]
+    journal.write_bytes(data[:5])  # not even a whole length prefix
+    assert read_table(out).num_rows == 0
+    report = resume(out)
+    assert report.computed == 3 and report.finished == 3
