@@ -1,4 +1,4 @@
-"""``gmuk campaign``: run, resume and summarise campaigns from the command line.
+"""``gmuk campaign``: run, resume and summarise campaigns from the command line::
 
     gmuk campaign SCENARIO --runs N [--seed S] [--workers W | --scheduler ADDR] --out DIR
                   [--set NAME=VALUE]… [--disperse NAME=SPEC]… [--sweep NAME=VALUES]…
@@ -143,8 +143,8 @@ def _parser() -> argparse.ArgumentParser:
     p = _Parser(
         prog="gmuk campaign",
         description="Monte Carlo dispersions and parameter sweeps of a scenario, stored "
-        "incrementally in DIR (resumable). "
-        + __doc__.split("Dispersion specs", 1)[1].split("\n\n")[0].replace("%", "%%"),
+        "incrementally in DIR (resumable).\n\nDispersion specs"
+        + __doc__.split("Dispersion specs", 1)[1].replace("``", "").replace("%", "%%"),
         allow_abbrev=False,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
