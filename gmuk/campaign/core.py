@@ -269,9 +269,11 @@ class Campaign:
 
         Notes
         -----
-        SIGINT or SIGTERM stop the campaign: no new run starts; runs in progress on worker
-        processes finish and are recorded (a second signal abandons them), a serial run in
-        progress stops at its next step and is not recorded. Continue with :func:`resume`.
+        SIGINT or SIGTERM stop the campaign: no new run starts; runs in progress on local
+        worker processes finish and are recorded (a second signal abandons them), a serial
+        run in progress stops at its next step and is not recorded, and on Dask the runs not
+        yet finished are cancelled (Dask does not tell a queued task from a running one).
+        Continue with :func:`resume`.
         """
         backend = _backend(workers, scheduler, connect_timeout_s)
         st = _store.ResultStore(out)
@@ -428,9 +430,10 @@ class _Processes(_Backend):
             return self.pool.submit(execute, campaign, k, out)
         except BrokenProcessPool:
             raise GmukError(
-                "the campaign's worker processes died; they are started with the 'spawn' "
-                "method, which imports the main script again: a script that runs a campaign "
-                "with workers > 1 must keep its code under if __name__ == '__main__':"
+                "the campaign's worker processes died (a crash, or a script without a main "
+                "guard: workers are started with the 'spawn' method, which imports the main "
+                "script again, so a script that runs a campaign with workers > 1 must keep its "
+                "code under if __name__ == '__main__':)"
             ) from None
 
     def wait(self, futures: set[Any], timeout: float) -> set[Any]:
@@ -621,6 +624,7 @@ def _drive(
 
     t0 = time.perf_counter()
     out = str(st.out)
+    abandoned = False  # a second signal: the runs in progress are dropped
     try:
         st.compact()
         done = st.finished()
@@ -654,8 +658,7 @@ def _drive(
             else:
                 queue = iter(todo)
                 running: set[Any] = set()
-                window = 2 * backend.slots + 2
-                abandoned = False
+                window = 2 * backend.slots + 2  # runs queued ahead, so no worker waits
                 while True:
                     if not stop.signals:
                         for k in itertools.islice(queue, max(0, window - len(running))):
@@ -682,7 +685,7 @@ def _drive(
                     backend.abandon()
         bar.close()
     finally:
-        if not locals().get("abandoned", False):
+        if not abandoned:
             backend.close()
     st.compact()
     table = _store.read_table(st.out)
