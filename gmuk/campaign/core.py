@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from gmuk import runs as _runs
 from gmuk.campaign import store as _store
 from gmuk.campaign.dispersions import Dispersion, check_sequence, dispersion_from_dict, magnitude
 from gmuk.campaign.models import CampaignModel, FunctionModel, get_model, model_from_dict
@@ -371,7 +372,10 @@ def execute(campaign: Campaign, k: int, out: str | None) -> dict[str, Any]:
             record["trajectory"] = str(rel)
         record |= {f"m_{name}": float(v) for name, v in metrics.items()}
     except Exception as exc:
-        record["status"] = "failed"
+        control = _runs.current()
+        # a model that fails on the short trajectory of a stopped run was stopped, not failed
+        stopped = control is not None and control.stop_requested
+        record["status"] = "interrupted" if stopped else "failed"
         record["error"] = f"{type(exc).__name__}: {exc}"
         record["traceback"] = traceback.format_exc()
     record["wall_time_s"] = time.perf_counter() - t0
@@ -619,8 +623,6 @@ def _drive(
     campaign: Campaign, st: _store.ResultStore, backend: _Backend, progress: bool | None
 ) -> CampaignReport:
     from tqdm.auto import tqdm
-
-    from gmuk import runs as _runs
 
     t0 = time.perf_counter()
     out = str(st.out)

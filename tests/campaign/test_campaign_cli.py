@@ -121,6 +121,28 @@ def test_sigint_stops_cleanly_and_resume_completes(tmp_path):
     _resume_and_check(out, finished, len(attempts))
 
 
+def test_sigterm_stops_a_serial_campaign_mid_run_and_resume_completes(tmp_path):
+    """Serially, the run in progress stops at its next step and is not recorded: every run
+    started has a row or an 'end K PID interrupted' line, and resume runs it again."""
+    out = tmp_path / "c"
+    proc = _start(out, workers=1)
+    try:
+        _wait_for_ends(proc, out, 4)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 143, err
+    finished = set(read_table(out).column("run").to_pylist())
+    assert 4 <= len(finished) < RUNS
+    log = (out / "attempts.log").read_text().splitlines()
+    started = {int(line.split()[1]) for line in log if line.startswith("start")}
+    interrupted = {int(line.split()[1]) for line in log if line.endswith(" interrupted")}
+    assert started == finished | interrupted and not finished & interrupted
+    _resume_and_check(out, finished, len(ResultStore(out).attempts()))
+
+
 def test_sigkill_leaves_a_readable_table_and_resume_completes(tmp_path):
     out = tmp_path / "c"
     proc = _start(out, workers=1)

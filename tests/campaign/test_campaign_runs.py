@@ -209,6 +209,24 @@ def test_a_folder_holding_a_campaign_is_refused_before_any_run(tmp_path):
         resume(tmp_path / "empty")
 
 
+def test_a_scheduler_address_runs_the_campaign_on_that_cluster(tmp_path):
+    """The address path (what --scheduler tcp://… takes), with a cluster of this test's."""
+    import distributed
+
+    campaign = Campaign("fcei", runs=3, seed=8, fixed=TINY)
+    campaign.run(tmp_path / "serial")
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        report = campaign.run(tmp_path / "addr", scheduler=cluster.scheduler_address)
+        assert report.backend == "dask" and report.complete
+        # the campaign closed its own client, not the cluster
+        assert cluster.status.name == "running"
+    assert all(
+        same(x, y) for x, y in zip(rows(tmp_path / "serial"), rows(tmp_path / "addr"), strict=True)
+    )
+
+
 def test_unreachable_scheduler_is_a_gmuk_error_before_any_run(tmp_path):
     campaign = Campaign("fcei", runs=2, fixed=TINY)
     with pytest.raises(GmukError, match=r"cannot reach the Dask scheduler at tcp://127\.0\.0\.1:9"):
