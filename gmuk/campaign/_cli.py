@@ -281,6 +281,8 @@ def main(argv: Sequence[str]) -> int:
                 raise OptionError(f"--set and --sweep both give {name!r}")
     elif any(name in model.default_grid for name in [*fixed, *given]):
         grid = {k: v for k, v in model.default_grid.items() if k not in fixed and k not in given}
+    if args.runs is None and not (model.default_grid if grid is None else grid):
+        raise OptionError(f"--runs N is required: {model.name} has no sweep here to count runs")
     campaign = Campaign(
         model,
         runs=args.runs,

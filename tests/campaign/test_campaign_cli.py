@@ -29,6 +29,8 @@ RUNS = 30
         (["fcei", "--runs", "3", "--disperse", "mass_scale=uniform:-0.5,1.2"], "must stay > 0"),
         (["fcei", "--runs", "3", "--set", "mass_scale=-1"], "must be > 0"),
         (["fcei", "--runs", "0"], "runs must be an integer ≥ 1"),
+        (["fcei"], "--runs N is required"),
+        (["apollo16", "--set", "degree=10"], "--runs N is required"),
         (["fcei", "--runs", "3", "--disperse", "orbits=zeta:1"], "unknown dispersion 'zeta'"),
         (["fcei", "--runs", "3", "--workers", "0"], "--workers must be ≥ 1"),
         (
