@@ -130,8 +130,8 @@ __all__ = [
     "uk",
 ]
 
-#: Submodules imported on first use (they pull in matplotlib, Pinocchio or the CLI).
-_LAZY = ("cli", "plotting", "scenarios", "view")
+#: Submodules imported on first use (they pull in matplotlib, Pinocchio, the CLI or campaigns).
+_LAZY = ("cli", "plotting", "scenarios", "view", "campaign")
 
 
 def __getattr__(name: str) -> object:

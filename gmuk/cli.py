@@ -7,6 +7,8 @@
     gmuk run NAME --help
     gmuk check [--seed S] [--samples N] [--verbose]
     gmuk view RUN_DIR_or_FILE.npz [--out FILE.html] [--central-radius M] [--max-frames N]
+    gmuk campaign SCENARIO --runs N [--workers W | --scheduler ADDR] --out DIR [...]
+    gmuk campaign --resume DIR | --summary DIR
 
 ``gmuk run`` writes ``DIR/trajectory.npz`` (loadable with :func:`gmuk.load_trajectory`),
 ``DIR/summary.json`` with the headline figures, the figures, and whatever further data the
@@ -90,6 +92,13 @@ def _parser() -> argparse.ArgumentParser:
     )
     check.add_argument("--verbose", action="store_true", help="print each row as computed")
     _add_view_parser(sub)
+    # issue #16: campaigns (gmuk.campaign._cli parses their arguments)
+    sub.add_parser(
+        "campaign",
+        help="Monte Carlo dispersions and sweeps of a scenario, resumable; 'gmuk campaign "
+        "--help' for its flags",
+        add_help=False,
+    )
     return p
 
 
@@ -407,6 +416,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if argv[:1] == ["run"]:
             return _run(argv[1:])
+        if argv[:1] == ["campaign"]:  # issue #16: gmuk campaign (see gmuk.campaign._cli)
+            from gmuk.campaign._cli import main as campaign_main
+
+            return campaign_main(argv[1:])
         args = _parser().parse_args(argv)
         if args.command == "list":
             found = scenarios.available()
