@@ -41,11 +41,44 @@ if TYPE_CHECKING:
     from gmuk.system import System
     from gmuk.trajectory import Trajectory
 
-__all__ = ["InequalityKKT", "KKTDiagnostics", "kkt_diagnostics"]
+__all__ = ["BoundConditions", "InequalityKKT", "KKTDiagnostics", "kkt_diagnostics"]
+
+
+class BoundConditions:
+    """The KKT conditions of one bound, from its KKT form ``g ≤ 0`` and multiplier ``μ``
+    (attributes ``g`` and ``mu`` of the class it is mixed into): shared by the simulated
+    (:class:`InequalityKKT`) and the optimised (:class:`gmuk.optimize.BoundKKT`) bounds."""
+
+    g: FloatArray
+    mu: FloatArray
+
+    @property
+    def primal_violation(self) -> FloatArray:
+        """max(g, 0): by how much the bound is exceeded (unit of h)."""
+        return np.maximum(self.g, 0.0)
+
+    @property
+    def dual_violation(self) -> FloatArray:
+        """max(−μ, 0): how far the multiplier is on the wrong side of zero."""
+        return np.maximum(-self.mu, 0.0)
+
+    @property
+    def complementarity(self) -> FloatArray:
+        """μ g (unit of μ times unit of h): zero at a KKT point."""
+        return self.mu * self.g
+
+    def summary(self) -> dict[str, float]:
+        """Maxima over the outputs: primal violation (unit of h), dual violation (unit of μ),
+        and the largest abs(μ g) (JSON-serialisable)."""
+        return {
+            "primal_violation_max": float(self.primal_violation.max(initial=0.0)),
+            "dual_violation_max": float(self.dual_violation.max(initial=0.0)),
+            "complementarity_abs_max": float(np.abs(self.complementarity).max(initial=0.0)),
+        }
 
 
 @dataclass(frozen=True, eq=False)
-class InequalityKKT:
+class InequalityKKT(BoundConditions):
     """KKT quantities of one bound along a trajectory (arrays of shape (N,)).
 
     Attributes
@@ -80,30 +113,6 @@ class InequalityKKT:
     slack_rate: FloatArray
     unit: str
     multiplier_unit: str
-
-    @property
-    def primal_violation(self) -> FloatArray:
-        """max(g, 0): by how much the bound is exceeded (unit of h)."""
-        return np.maximum(self.g, 0.0)
-
-    @property
-    def dual_violation(self) -> FloatArray:
-        """max(−μ, 0): how far the multiplier is on the wrong side of zero."""
-        return np.maximum(-self.mu, 0.0)
-
-    @property
-    def complementarity(self) -> FloatArray:
-        """μ g (unit of μ times unit of h): zero at a KKT point."""
-        return self.mu * self.g
-
-    def summary(self) -> dict[str, float]:
-        """Maxima over the outputs: primal violation (unit of h), dual violation (unit of μ),
-        and the largest abs(μ g) (JSON-serialisable)."""
-        return {
-            "primal_violation_max": float(self.primal_violation.max(initial=0.0)),
-            "dual_violation_max": float(self.dual_violation.max(initial=0.0)),
-            "complementarity_abs_max": float(np.abs(self.complementarity).max(initial=0.0)),
-        }
 
 
 @dataclass(frozen=True, eq=False)

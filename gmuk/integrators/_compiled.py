@@ -568,6 +568,16 @@ def _interpolate(F, Y0, s, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
+def _stage_state(Y, h, a, K, i, out):  # type: ignore[no-untyped-def]
+    """out = Y + h Σ_{m<i} a_m K_m: the state at which stage i is evaluated."""
+    for j in range(Y.shape[0]):
+        q = 0.0
+        for m in range(i):
+            q += a[m] * K[m, j]
+        out[j] = Y[j] + h * q
+
+
+@njit(cache=True)
 def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux):  # type: ignore[no-untyped-def]
     """Run steps from (fs[F_T], Y, G0) with f0 = f(t, Y) and the outputs ``aux`` of that
     evaluation (see :func:`rhs`), until the end time, ``ints[I_CHUNK]`` steps, full output
@@ -646,11 +656,7 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
             K[0, j] = f0[j]
         bad = 0
         for i in range(1, s):
-            for j in range(n):
-                q = 0.0
-                for m in range(i):
-                    q += A[i, m] * K[m, j]
-                Yt[j] = Y[j] + h_try * q
+            _stage_state(Y, h_try, A[i], K, i, Yt)
             ints[I_RHS] += 1
             bad = rhs(t + c[i] * h_try, Yt, G0, parts, K[i], tmp_aux)
             if bad != 0:
@@ -714,11 +720,7 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
                 for j in range(n):
                     Kx[i, j] = K[i, j]
             for i in range(ne_rows, _tab.N_STAGES_EXTENDED):
-                for j in range(n):
-                    q = 0.0
-                    for m in range(i):
-                        q += Ax[i, m] * Kx[m, j]
-                    Yt[j] = Y[j] + h_try * q
+                _stage_state(Y, h_try, Ax[i], Kx, i, Yt)
                 ints[I_RHS] += 1
                 bad = rhs(t + Cx[i] * h_try, Yt, G0, parts, Kx[i], tmp_aux)
                 if bad != 0:

@@ -13,6 +13,7 @@ import numpy as np
 from gmuk._validation import FloatArray
 from gmuk.control.base import Controller
 from gmuk.errors import DefinitionError
+from gmuk.kkt import BoundConditions
 from gmuk.lie import so3
 from gmuk.optimize.lgl import interpolation_matrix
 from gmuk.optimize.mesh import Mesh
@@ -30,7 +31,7 @@ __all__ = [
 
 
 @dataclass(frozen=True, eq=False)
-class BoundKKT:
+class BoundKKT(BoundConditions):
     """KKT quantities of one side of a path inequality at the nodes (arrays (n,)).
 
     The same names as :class:`gmuk.kkt.InequalityKKT`, so that
@@ -57,29 +58,6 @@ class BoundKKT:
     mu: FloatArray
     unit: str
     multiplier_unit: str
-
-    @property
-    def primal_violation(self) -> FloatArray:
-        """max(g, 0) (unit of h)."""
-        return np.maximum(self.g, 0.0)
-
-    @property
-    def dual_violation(self) -> FloatArray:
-        """max(−μ, 0)."""
-        return np.maximum(-self.mu, 0.0)
-
-    @property
-    def complementarity(self) -> FloatArray:
-        """μ g, zero at a KKT point."""
-        return self.mu * self.g
-
-    def summary(self) -> dict[str, float]:
-        """Maxima of the primal and dual violations and of abs(μ g)."""
-        return {
-            "primal_violation_max": float(self.primal_violation.max(initial=0.0)),
-            "dual_violation_max": float(self.dual_violation.max(initial=0.0)),
-            "complementarity_abs_max": float(np.abs(self.complementarity).max(initial=0.0)),
-        }
 
 
 @dataclass(frozen=True, eq=False)
