@@ -148,7 +148,9 @@ def _parser() -> argparse.ArgumentParser:
         allow_abbrev=False,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("scenario", nargs="?", help="fcei, ucei or apollo16")
+    from gmuk.campaign.models import supported
+
+    p.add_argument("scenario", nargs="?", help=", ".join(supported()))
     p.add_argument(
         "--runs", type=int, default=None, help="number of runs (default: the sweep's size)"
     )

@@ -14,6 +14,11 @@ with campaign support each have one (:data:`MODELS`, :func:`get_model`):
     Baumgarte stabilisation from a dispersed start, the spacecraft starts with it, free to
     roll about axis 1 (roll-rate error dispersed), its relative velocity held by a
     velocity-level Baumgarte term.
+``fccl``
+    The Chapter 5 closed loop: the corrected Morse–Lyapunov controller returns the
+    spacecraft to the FCEI reference from a dispersed start (attitude errors up to 179° by
+    default, position, velocity and body-rate errors, the integral gain): the
+    almost-global convergence study.
 ``apollo16``
     The Chapter 3 orbit (§3.4): the free LM in the GRAIL field GRGM660PRIM truncated at
     ``degree`` (gmuk's correct model), compared with the uniform-field run — the gravity-
@@ -559,8 +564,95 @@ class Apollo16Model(CampaignModel):
         return traj, {**metrics, **_basic_metrics(traj)}
 
 
+def _default_fccl_dispersions() -> dict[str, Dispersion]:
+    from gmuk.campaign.dispersions import AttitudeCone, GaussianVector, UniformBall
+
+    return {
+        "attitude_error": AttitudeCone(math.radians(179.0)),
+        "position_error_m": UniformBall(1000.0),
+        "velocity_error_m_s": GaussianVector(0.1),
+        "rate_error_rad_s": GaussianVector(0.01),
+    }
+
+
+class FCCLModel(CampaignModel):
+    """The Chapter 5 closed loop: the corrected Morse–Lyapunov tracking law (Eq. 81) takes
+    the spacecraft back to the FCEI reference from a dispersed start — the almost-global
+    convergence study (McCann 2020, §5.1; ``gmuk run fccl``)."""
+
+    name = "fccl"
+    description = "FCCL: the corrected tracking controller from dispersed starts (Ch. 5)"
+    parameters: tuple[Parameter, ...] = (
+        Parameter("attitude_error", "rotation", (0.0, 0.0, 0.0), "initial attitude error (rad)"),
+        Parameter("position_error_m", "vector3", (0.0, 0.0, 0.0), "initial position error (m, N)"),
+        Parameter(
+            "velocity_error_m_s", "vector3", (0.0, 0.0, 0.0), "initial velocity error (m/s, N)"
+        ),
+        Parameter(
+            "rate_error_rad_s", "vector3", (0.0, 0.0, 0.0), "initial body-rate error (rad/s, B)"
+        ),
+        Parameter("k_integral", "real", 0.0, "the controller's integral gain k_I (1/s²)", low=0.0),
+        Parameter(
+            "orbits",
+            "real",
+            0.1,
+            "duration, in periods of the FCEI orbit",
+            low=0.0,
+            low_open=True,
+            high=1e3,
+        ),
+        Parameter("samples", "integer", 101, "output times per run", low=2, high=1e6),
+        Parameter("rtol", "real", 1e-9, "integrator rtol = atol (DOPRI5)", low=0.0, low_open=True),
+    )
+    headline = ("final_attitude_error_rad", "final_position_error_m")
+
+    @property
+    def default_dispersions(self) -> Mapping[str, Dispersion]:  # type: ignore[override]
+        return _default_fccl_dispersions()
+
+    def run(self, params: Mapping[str, Any]) -> tuple[Trajectory | None, dict[str, float]]:
+        from gmuk.orbits import LVLHReference
+        from gmuk.scenarios import _lvlh as common
+        from gmuk.scenarios import fccl
+
+        system, _, orbit = fccl.build(k_integral=params["k_integral"])
+        r0 = LVLHReference(orbit).evaluate(0.0)
+        g0 = _attitude_pose(r0.g, params["attitude_error"], params["position_error_m"])
+        V0 = _dispersed_twist(r0.g, r0.V, g0, params["velocity_error_m_s"])
+        V0[:3] += np.asarray(params["rate_error_rad_s"], dtype=float)
+        state = system.state(g={fccl.BODY: g0}, V={fccl.BODY: V0})
+        t = np.linspace(0.0, params["orbits"] * orbit.period, params["samples"])
+        traj = system.simulate(
+            state,
+            (0.0, float(t[-1])),
+            t_eval=t,
+            rtol=params["rtol"],
+            atol=params["rtol"],
+            method=fccl.METHOD,
+            max_step=fccl.MAX_STEP,
+            on_failure="return",
+        )
+        pos, att = common.reference_errors(traj, orbit, fccl.BODY)
+        u = traj.body(fccl.BODY).control_force
+        metrics = {
+            "initial_position_error_m": float(pos[0]),
+            "initial_attitude_error_rad": float(att[0]),
+            "final_position_error_m": float(pos[-1]),
+            "final_attitude_error_rad": float(att[-1]),
+            "max_position_error_m": float(pos.max()),
+            "max_attitude_error_rad": float(att.max()),
+            "position_settling_time_s": _settling_time(traj.t, pos),
+            "attitude_settling_time_s": _settling_time(traj.t, att),
+            "peak_control_torque_N_m": float(np.linalg.norm(u[:, :3], axis=1).max()),
+            "peak_control_force_N": float(np.linalg.norm(u[:, 3:], axis=1).max()),
+        }
+        return traj, {**metrics, **_basic_metrics(traj)}
+
+
 #: gmuk's scenarios with campaign support: name → model.
-MODELS: dict[str, CampaignModel] = {m.name: m for m in (FCEIModel(), UCEIModel(), Apollo16Model())}
+MODELS: dict[str, CampaignModel] = {
+    m.name: m for m in (FCEIModel(), UCEIModel(), FCCLModel(), Apollo16Model())
+}
 
 
 def supported() -> list[str]:

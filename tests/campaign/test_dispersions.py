@@ -154,7 +154,9 @@ def test_campaign_refuses_a_dispersion_that_can_leave_its_parameter_domain():
 
 
 def test_unknown_or_unsupported_scenarios_list_the_supported_ones():
-    with pytest.raises(DefinitionError, match=r"unknown scenario 'nosuch'.*fcei, ucei, apollo16"):
+    with pytest.raises(
+        DefinitionError, match=r"unknown scenario 'nosuch'.*fcei, ucei, fccl, apollo16"
+    ):
         Campaign("nosuch", runs=2)
     with pytest.raises(DefinitionError, match=r"'smd-gt' has no campaign support.*fcei"):
         Campaign("smd-gt", runs=2)
