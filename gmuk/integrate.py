@@ -795,37 +795,6 @@ class _CompiledStepper(_Stepper):
         bar: _Progress,
         resume: dict[str, Any] | None = None,
     ) -> None:
-        prog = self.program
-        if not prog.python_forces:
-            self._run(state0, t_end, outs, rec, max_steps, bar, resume)
-            return
-        # the user's force models, called back from the compiled loop
-        system, problem, plan = self.p.system, self.p, prog.python_forces
-
-        def loads(
-            t: float, Y: FloatArray, G0: FloatArray, modeled: FloatArray, unmodeled: FloatArray
-        ) -> None:
-            system._accumulate_loads(problem.state(t, Y, G0), plan, modeled, unmodeled)
-
-        key = id(self)
-        _compiled.CALLBACKS[key] = loads
-        prog.parts[9][5] = key
-        try:
-            self._run(state0, t_end, outs, rec, max_steps, bar, resume)
-        finally:
-            prog.parts[9][5] = -1
-            del _compiled.CALLBACKS[key]
-
-    def _run(
-        self,
-        state0: State,
-        t_end: float,
-        outs: FloatArray | None,
-        rec: _Recorder,
-        max_steps: int,
-        bar: _Progress,
-        resume: dict[str, Any] | None,
-    ) -> None:
         p, m, prog = self.p, self.method, self.program
         n, n_dof = p.size, p.layout.n_dof
         ints = np.zeros(9, dtype=np.int64)
@@ -881,14 +850,16 @@ class _CompiledStepper(_Stepper):
         ints[_compiled.I_CHUNK] = self.chunk
         fs[_compiled.F_H] = h
         self.at = (Y.copy(), G0.copy(), h, int(ints[_compiled.I_OUT]))
-
-        def sync() -> tuple[float, float, int]:
-            """Take the chunk's outputs and the last accepted step (also after an error
-            raised by a user's part called back from the loop)."""
+        while True:
+            fs[_compiled.F_T] = t
+            ints[_compiled.I_WRITTEN] = 0
+            status = _compiled.advance(
+                prog.parts, prog.method, fs, ints, Y, G0, f0, aux,
+                out_arr, outs is not None, *bufs,
+            )  # fmt: skip
             n_out = int(ints[_compiled.I_WRITTEN])
             if n_out:
                 rec.add_block(self._block(n_out, bufs, acc0))
-            ints[_compiled.I_WRITTEN] = 0
             t, h = float(fs[_compiled.F_T]), float(fs[_compiled.F_H])
             self.t = t
             p.G0 = G0
@@ -896,20 +867,6 @@ class _CompiledStepper(_Stepper):
             self.n_steps = int(ints[_compiled.I_STEPS])
             self.n_rejected = int(ints[_compiled.I_REJECTED])
             self.at = (Y.copy(), G0.copy(), h, int(ints[_compiled.I_OUT]))
-            return t, h, n_out
-
-        while True:
-            fs[_compiled.F_T] = t
-            ints[_compiled.I_WRITTEN] = 0
-            try:
-                status = _compiled.advance(
-                    prog.parts, prog.method, fs, ints, Y, G0, f0, aux,
-                    out_arr, outs is not None, *bufs,
-                )  # fmt: skip
-            except BaseException:
-                sync()
-                raise
-            t, h, n_out = sync()
             bar.update(t)
             if status == _compiled.DONE:
                 return

@@ -496,20 +496,8 @@ class System:
             return self._zero_loads, self._zero_loads
         n = self.layout.n_dof
         modeled, unmodeled = np.zeros(n), np.zeros(n)
-        self._accumulate_loads(state, self._force_plan, modeled, unmodeled)
-        return modeled, unmodeled
-
-    def _accumulate_loads(
-        self,
-        state: State,
-        plan: Sequence[tuple[ForceModel, list[Body], Any]],
-        modeled: FloatArray,
-        unmodeled: FloatArray,
-    ) -> None:
-        """Add the generalized forces (n_dof,) of the force models of ``plan`` (entries of
-        ``_force_plan``) into ``modeled`` and ``unmodeled``."""
         t = state.t
-        for f, bodies, slots in plan:
+        for f, bodies, slots in self._force_plan:
             target = modeled if f.modeled else unmodeled
             if slots is None:
                 for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
@@ -528,6 +516,7 @@ class System:
                             f"{body.name!r}; expected ({dof},)"
                         )
                 target[offset : offset + dof] += w
+        return modeled, unmodeled
 
     def _force_slot(self, body: Body) -> tuple[Body, bool, int, int, int]:
         s = self.layout.slot(body)

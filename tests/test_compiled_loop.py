@@ -176,6 +176,8 @@ class LoudGravity(gmuk.PointMassGravity):
 @pytest.mark.parametrize(
     ("make", "why"),
     [
+        (lambda s: gmuk.System(s.bodies, [], [gmuk.PointMassGravity(MU), Drag()]), "'Drag'"),
+        (lambda s: gmuk.System(s.bodies, [], [LoudGravity(MU)]), "'LoudGravity'"),
         (
             lambda s: gmuk.System(
                 s.bodies,
@@ -185,7 +187,7 @@ class LoudGravity(gmuk.PointMassGravity):
             "'fused'",
         ),
     ],
-    ids=["constraint on a point mass"],
+    ids=["user force model", "overridden built-in", "constraint on a point mass"],
 )
 def test_a_system_that_does_not_qualify_runs_the_python_loop_and_says_why(make, why):
     base, _ = _system([])
@@ -345,57 +347,3 @@ def test_a_constrained_compiled_run_equals_the_python_run():
         np.testing.assert_allclose(fast.multipliers[k], lam, rtol=0, atol=1e-8 * scale)
     np.testing.assert_array_equal(fast.rank, slow.rank)
     assert fast.residual.max() < 1e-9 and slow.residual.max() < 1e-9
-
-
-class Exploding(gmuk.ForceModel):
-    """A user's model that raises once t passes ``t_bad``."""
-
-    def __init__(self, t_bad):
-        super().__init__()
-        self.t_bad = t_bad
-
-    def force(self, t, r_N, v_N, body):
-        if t > self.t_bad:
-            raise RuntimeError(f"model failed at t = {t:.3f} s")
-        return np.zeros(3)
-
-    def wrench(self, t, g_NB, V_B, body):
-        return np.zeros(6)
-
-
-@pytest.mark.parametrize(
-    "user", [Drag(), LoudGravity(MU), Drag(modeled=False)], ids=["drag", "override", "unmodeled"]
-)
-def test_a_users_python_part_among_compiled_ones_runs_in_the_compiled_loop(user):
-    system, state = _system([gmuk.GravityGradient(MU), user])
-    prog = _program(system)
-    assert [f for f, _, _ in prog.python_forces] == [user]
-    kw = {"t_eval": np.linspace(0.0, 2000.0, 5), "rtol": 1e-11, "atol": 1e-11}
-    fast = system.simulate(state, (0.0, 2000.0), **kw)
-    slow = system.simulate(state, (0.0, 2000.0), compiled=False, **kw)
-    assert fast.stats["compiled"] and fast.success
-    assert fast.stats["n_steps"] == slow.stats["n_steps"]
-    np.testing.assert_allclose(fast.r_N, slow.r_N, rtol=0, atol=1e-13 * R0)
-    np.testing.assert_allclose(fast.V_B, slow.V_B, rtol=0, atol=1e-12 * V0)
-    np.testing.assert_allclose(
-        fast.unmodeled_force, slow.unmodeled_force, rtol=0, atol=1e-12 * 500 * 2.0
-    )
-
-
-def test_a_users_part_that_raises_inside_the_compiled_loop_fails_as_in_the_python_loop():
-    system, state = _system([gmuk.PointMassGravity(MU), Exploding(1234.5)])
-    t_eval = np.linspace(0.0, 3000.0, 61)
-    errors = []
-    for compiled in (None, False):
-        with pytest.raises(SimulationError, match="RuntimeError: model failed at t") as info:
-            system.simulate(state, (0.0, 3000.0), t_eval=t_eval, compiled=compiled)
-        errors.append(info.value)
-    fast, slow = (e.trajectory for e in errors)
-    assert fast.stats["compiled"] and not slow.stats["compiled"]
-    # the same message, but for the last digits of the last good step's time
-    assert str(errors[0]).split(" s: ")[1] == str(errors[1]).split(" s: ")[1]
-    assert fast.stats["n_steps"] == slow.stats["n_steps"]
-    np.testing.assert_array_equal(fast.t, slow.t)  # the outputs up to the last good step
-    assert fast.t[-1] <= 1234.5 < fast.t[-1] + 50.0 + 1e-9
-    np.testing.assert_allclose(fast.r_N, slow.r_N, rtol=0, atol=1e-13 * R0)
-    assert not _compiled.CALLBACKS  # nothing left behind

@@ -26,7 +26,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numba import objmode
 
 from gmuk._numba import njit
 from gmuk._uk_kernels import relative_rows, rigid_free_accel, tracking_b, uk_rigid
@@ -80,18 +79,6 @@ class Program:
     n: int
     #: rows of the stacked constraints
     s: int
-    #: the force models without a compiled form, as System._force_plan lists them: the loop
-    #: calls them back in Python through :data:`CALLBACKS`
-    python_forces: list[tuple[Any, list[Any], Any]]
-
-
-#: Python callbacks of running compiled loops, by key: ``fn(t, Y, G0, modeled, unmodeled)``
-#: adds the Python force models' generalized forces into the two (n_dof,) arrays.
-CALLBACKS: dict[int, Any] = {}
-
-
-def _python_loads(key: int, t: float, Y: Any, G0: Any, modeled: Any, unmodeled: Any) -> None:
-    CALLBACKS[key](t, Y, G0, modeled, unmodeled)
 
 
 def _generic(method: RungeKuttaMethod) -> bool:
@@ -128,16 +115,13 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
     fields: list[np.ndarray] = []
     field_at: dict[int, tuple[int, int]] = {}
     n_field = 0
-    python_forces: list[tuple[Any, list[Any], Any]] = []
-    for f, bodies, slots in system._force_plan:
-        terms_f = None if slots is None else [f._compiled_term(sl[0]) for sl in slots]
-        if terms_f is None or any(term is None for term in terms_f):
-            # called back in Python from the compiled loop (numba's object mode)
-            python_forces.append((f, bodies, slots))
-            continue
-        assert slots is not None
-        for (_body, rigid, index, offset, _dof), term in zip(slots, terms_f, strict=True):
-            assert term is not None
+    for f, _bodies, slots in system._force_plan:
+        if slots is None:
+            return f"force model {f.name!r} couples bodies (wrenches)"
+        for body, rigid, index, offset, _dof in slots:
+            term = f._compiled_term(body)
+            if term is None:
+                return f"force model {f.name!r} has no compiled form on body {body.name!r}"
             code, values, data = term
             f0 = f1 = 0
             if data is not None:
@@ -165,9 +149,8 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
         np.ascontiguousarray(system._m_euclid, dtype=float).reshape(ne),
         np.asarray(lay.rigid_offsets, dtype=np.int64),
         np.asarray(lay.euclid_offsets, dtype=np.int64),
-        # the last entry: the key of the Python force models' callback (set by the caller)
         np.array(
-            [nr, ne, lay.n_dof, int(system._plant_only_loads), int(cons[:, 4].sum()), -1],
+            [nr, ne, lay.n_dof, int(system._plant_only_loads), int(cons[:, 4].sum())],
             dtype=np.int64,
         ),
         cons,
@@ -199,7 +182,7 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
         np.ascontiguousarray(_tab.D),
         ints,
     )
-    return Program(parts, meth, 12 * nr + 2 * ne, int(cons[:, 4].sum()), python_forces)
+    return Program(parts, meth, 12 * nr + 2 * ne, int(cons[:, 4].sum()))
 
 
 # Constraint kinds of the compiled right-hand side.
@@ -325,9 +308,6 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
         else:
             for i in range(dof):
                 unmodeled[off + i] += w[i]
-    if dims[5] >= 0:  # the user's force models, in Python
-        with objmode():
-            _python_loads(dims[5], t, Y, G0, modeled, unmodeled)
     if s:
         # rigid bodies only (the fused strategy): the rows, then one compiled UK solve
         A = np.zeros((s, ndof))
