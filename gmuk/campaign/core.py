@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import hashlib
-import itertools
 import math
 import os
 import signal
@@ -383,6 +382,18 @@ def execute(campaign: Campaign, k: int, out: str | None) -> dict[str, Any]:
     return record
 
 
+def execute_many(campaign: Campaign, ks: Sequence[int], out: str | None) -> list[dict[str, Any]]:
+    """:func:`execute` for each of the runs ``ks`` in turn (one task of a backend)."""
+    return [execute(campaign, k, out) for k in ks]
+
+
+#: A task holds runs worth about this much time (s), so that a backend's cost per task (about
+#: 2 ms on a Dask LocalCluster, 0.4 ms on local processes) is a few percent of it at most.
+TASK_S = 0.1
+#: The most runs in one task.
+TASK_RUNS_MAX = 64
+
+
 # --- backends ------------------------------------------------------------------------------------
 
 
@@ -397,7 +408,8 @@ class _Backend:
     name = "serial"
     slots = 1
 
-    def submit(self, campaign: Campaign, k: int, out: str) -> Any:
+    def submit(self, campaign: Campaign, ks: list[int], out: str) -> Any:
+        """A future of the records (a list) of the runs ``ks``."""
         raise NotImplementedError
 
     def wait(self, futures: set[Any], timeout: float) -> set[Any]:
@@ -427,11 +439,11 @@ class _Processes(_Backend):
             workers, mp_context=multiprocessing.get_context("spawn"), initializer=_ignore_sigint
         )
 
-    def submit(self, campaign: Campaign, k: int, out: str) -> Any:
+    def submit(self, campaign: Campaign, ks: list[int], out: str) -> Any:
         from concurrent.futures.process import BrokenProcessPool
 
         try:
-            return self.pool.submit(execute, campaign, k, out)
+            return self.pool.submit(execute_many, campaign, ks, out)
         except BrokenProcessPool:
             raise GmukError(
                 "the campaign's worker processes died (a crash, or a script without a main "
@@ -506,14 +518,14 @@ class _Dask(_Backend):
             self.client = distributed.Client(scheduler)
         self.slots = max(1, sum(self.client.nthreads().values()))
 
-    def submit(self, campaign: Campaign, k: int, out: str) -> Any:
+    def submit(self, campaign: Campaign, ks: list[int], out: str) -> Any:
         return self.client.submit(
-            execute,
+            execute_many,
             campaign,
-            k,
+            ks,
             out,
             pure=False,
-            key=f"gmuk-run-{k}-{os.getpid()}-{time.monotonic_ns()}",
+            key=f"gmuk-runs-{ks[0]}-{len(ks)}-{os.getpid()}-{time.monotonic_ns()}",
         )
 
     def wait(self, futures: set[Any], timeout: float) -> set[Any]:
@@ -619,6 +631,12 @@ def _signals(stop: _Stop) -> Iterator[None]:
             signal.signal(sig, handler)
 
 
+#: The longest finished runs wait before the journal gets them (s): one chunk per interval
+#: instead of one per run, so that a run costs well under a millisecond of bookkeeping; a
+#: SIGKILL loses at most this much finished work (its runs are done again on resume).
+FLUSH_S = 0.25
+
+
 def _drive(
     campaign: Campaign, st: _store.ResultStore, backend: _Backend, progress: bool | None
 ) -> CampaignReport:
@@ -627,6 +645,7 @@ def _drive(
     t0 = time.perf_counter()
     out = str(st.out)
     abandoned = False  # a second signal: the runs in progress are dropped
+    pending: list[dict[str, Any]] = []  # finished records not yet in the journal
     try:
         st.compact()
         done = st.finished()
@@ -641,13 +660,20 @@ def _drive(
         )
         stop = _Stop()
         computed = 0
+        last_flush = time.monotonic()
 
-        def store(records: list[dict[str, Any]]) -> None:
-            nonlocal computed
+        def store(records: list[dict[str, Any]], *, flush: bool = False) -> None:
+            """Keep the finished records; write them to the journal as one chunk at most
+            every FLUSH_S seconds (and when the campaign ends or stops)."""
+            nonlocal computed, last_flush
             kept = [r for r in records if r["status"] != "interrupted"]
-            st.append(kept)
+            pending.extend(kept)
             computed += len(kept)
             bar.update(len(kept))
+            if pending and (flush or time.monotonic() - last_flush >= FLUSH_S):
+                st.append(pending)
+                pending.clear()
+                last_flush = time.monotonic()
 
         with _signals(stop):
             if backend.name == "serial":
@@ -658,13 +684,19 @@ def _drive(
                             break
                         store([execute(campaign, k, out)])
             else:
-                queue = iter(todo)
+                queue = list(reversed(todo))  # popped from the end: in run order
                 running: set[Any] = set()
-                window = 2 * backend.slots + 2  # runs queued ahead, so no worker waits
+                window = 2 * backend.slots + 2  # tasks queued ahead, so no worker waits
+                per_task = 1  # runs per task, from the runs' own times once some are known
+                times: list[float] = []
                 while True:
                     if not stop.signals:
-                        for k in itertools.islice(queue, max(0, window - len(running))):
-                            running.add(backend.submit(campaign, k, out))
+                        while queue and len(running) < window:
+                            # never so many per task that a worker is left without one
+                            share = -(-len(queue) // (2 * backend.slots))
+                            n = max(1, min(per_task, share))
+                            ks = [queue.pop() for _ in range(min(n, len(queue)))]
+                            running.add(backend.submit(campaign, ks, out))
                     elif len(stop.signals) == 1 and running:
                         backend.cancel(running)
                     if len(stop.signals) > 1:
@@ -679,14 +711,21 @@ def _drive(
                         if f.cancelled():
                             continue
                         try:
-                            records.append(f.result())
-                        except BaseException:  # a lost worker: the run stays to do
+                            records.extend(f.result())
+                        except BaseException:  # a lost worker: its runs stay to do
                             continue
+                    times += [r["wall_time_s"] for r in records if r["status"] == "success"]
+                    if times:
+                        mean = max(float(np.mean(times[-50:])), 1e-6)
+                        per_task = int(min(TASK_RUNS_MAX, max(1, TASK_S // mean)))
                     store(records)
                 if abandoned:
                     backend.abandon()
+        store([], flush=True)
         bar.close()
     finally:
+        if pending:  # an error in the loop: keep what finished
+            st.append(pending)
         if not abandoned:
             backend.close()
     st.compact()

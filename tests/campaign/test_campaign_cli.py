@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from gmuk.campaign import read_table
+from gmuk.campaign.core import FLUSH_S
 from gmuk.campaign.store import ResultStore
 from gmuk.cli import main
 
@@ -63,7 +64,8 @@ def test_campaign_summary_and_parameters_from_the_command_line(tmp_path, capsys)
 def _start(out: Path, workers: int) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1"}
     argv = [sys.executable, "-m", "gmuk.cli", "campaign", "fcei", "--runs", str(RUNS)]
-    argv += ["--set", "orbits=0.004", "--set", "samples=11", "--seed", "9"]
+    # runs of 0.05–0.1 s (the compiled loop): long enough to signal a campaign midway
+    argv += ["--set", "orbits=0.3", "--set", "samples=11", "--seed", "9"]
     argv += ["--workers", str(workers), "--out", str(out), "--no-progress"]
     return subprocess.Popen(
         argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True
@@ -150,6 +152,9 @@ def test_sigkill_leaves_a_readable_table_and_resume_completes(tmp_path):
     proc = _start(out, workers=1)
     try:
         _wait_for_ends(proc, out, 5)
+        # finished runs reach the journal within FLUSH_S (one chunk per interval): give the
+        # five that ended that long, so the kill costs at most the runs after them
+        time.sleep(FLUSH_S + 0.2)
         os.killpg(proc.pid, signal.SIGKILL)  # the campaign's own process group
         proc.communicate(timeout=60)
     finally:
