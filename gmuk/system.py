@@ -411,7 +411,8 @@ class System:
         for b in self.bodies:
             sl = lay.slot(b)
             if b.kind is BodyKind.RIGID:
-                G[sl.index] = check_se3(given["g"][b.name], f"g[{b.name!r}]")
+                pose = as_array(given["g"][b.name], (4, 4), f"g[{b.name!r}]", batch=False)
+                G[sl.index] = check_se3(pose, f"g[{b.name!r}]")
                 Vs[sl.index] = as_array(given["V"][b.name], (6,), f"V[{b.name!r}]", batch=False)
             elif b.name not in self._owned_names:  # owned ones are set below
                 kq, kv = need[b.kind]

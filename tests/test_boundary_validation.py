@@ -153,3 +153,12 @@ def test_part_constructors_refuse_hostile_values_with_gmuk_errors(name, value):
         return
     with pytest.raises(gmuk.errors.GmukError):
         CONSTRUCTORS[name](value)
+
+
+def test_state_refuses_an_empty_batch_of_poses_for_one_body():
+    # found by the slow fuzz suite: a (0, 4, 4) pose passed the group check (nothing to
+    # check) and failed later with numpy's broadcast error
+    body = gmuk.RigidBody("a", 1.0, np.eye(3))
+    system = gmuk.System([body])
+    with pytest.raises(gmuk.errors.ShapeError, match=r"g\['a'\] must have shape \(4, 4\)"):
+        system.state(g={"a": np.zeros((0, 4, 4))}, V={"a": np.zeros(6)})
