@@ -1,10 +1,12 @@
 """The compiled step loop: the RKMK integrator of :mod:`gmuk.integrate`, run in machine code
 for a System whose parts all have compiled forms.
 
-A System qualifies when it has no constraints and no controllers, its bodies are rigid bodies
-and point masses, and each of its force models gives a compiled term for each of its bodies
+A System qualifies when it has no controllers, its bodies are rigid bodies and point masses,
+each of its force models gives a compiled term for each of its bodies
 (``ForceModel._compiled_term``: the built-in gravity, uniform-gravity and linear spring–damper
-models, unless a subclass overrides their methods). The method must be one whose step is its
+models, unless a subclass overrides their methods), and it has either no constraints or only
+rigid bodies held by LVLH configuration tracking and relative constraints under the fused
+solve (:func:`_constraint_program`). The method must be one whose step is its
 tableau (every :class:`~gmuk.integrators.RungeKuttaMethod` that keeps the base class's
 ``stages``, ``error_norm`` and has no continuous extension of its own) or DOP853 itself.
 :func:`program` derives the compiled form from the parts once per call of ``simulate``; the
