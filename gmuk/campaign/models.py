@@ -302,6 +302,22 @@ def _settling_time(t: np.ndarray, err: np.ndarray, fraction: float = 0.02) -> fl
     return float(t[last + 1]) if last + 1 < len(t) else math.nan
 
 
+def _span(orbits: float, samples: int) -> tuple[Parameter, Parameter]:
+    """The duration (in FCEI periods) and output-count parameters, with these defaults."""
+    return (
+        Parameter(
+            "orbits",
+            "real",
+            orbits,
+            "duration, in periods of the FCEI orbit",
+            low=0.0,
+            low_open=True,
+            high=1e3,
+        ),
+        Parameter("samples", "integer", samples, "output times per run", low=2, high=1e6),
+    )
+
+
 _ERRORS = (
     Parameter("attitude_error", "rotation", (0.0, 0.0, 0.0), "initial attitude error θn̂ (rad)"),
     Parameter("position_error_m", "vector3", (0.0, 0.0, 0.0), "initial position error (m, N)"),
@@ -325,16 +341,7 @@ _ERRORS = (
         low=0.0,
     ),
     Parameter("baumgarte_zeta", "real", 1.0, "Baumgarte damping ratio ζ", low=0.0),
-    Parameter(
-        "orbits",
-        "real",
-        0.01,
-        "duration, in periods of the FCEI orbit",
-        low=0.0,
-        low_open=True,
-        high=1e3,
-    ),
-    Parameter("samples", "integer", 201, "output times per run", low=2, high=1e6),
+    *_span(orbits=0.01, samples=201),
     Parameter("rtol", "real", 1e-12, "integrator rtol", low=0.0, low_open=True),
     Parameter("atol", "real", 1e-9, "integrator atol", low=0.0, low_open=True),
 )
@@ -583,25 +590,12 @@ class FCCLModel(CampaignModel):
     name = "fccl"
     description = "FCCL: the corrected tracking controller from dispersed starts (Ch. 5)"
     parameters: tuple[Parameter, ...] = (
-        Parameter("attitude_error", "rotation", (0.0, 0.0, 0.0), "initial attitude error (rad)"),
-        Parameter("position_error_m", "vector3", (0.0, 0.0, 0.0), "initial position error (m, N)"),
-        Parameter(
-            "velocity_error_m_s", "vector3", (0.0, 0.0, 0.0), "initial velocity error (m/s, N)"
-        ),
+        *_ERRORS[:3],  # attitude, position and velocity errors
         Parameter(
             "rate_error_rad_s", "vector3", (0.0, 0.0, 0.0), "initial body-rate error (rad/s, B)"
         ),
         Parameter("k_integral", "real", 0.0, "the controller's integral gain k_I (1/s²)", low=0.0),
-        Parameter(
-            "orbits",
-            "real",
-            0.1,
-            "duration, in periods of the FCEI orbit",
-            low=0.0,
-            low_open=True,
-            high=1e3,
-        ),
-        Parameter("samples", "integer", 101, "output times per run", low=2, high=1e6),
+        *_span(orbits=0.1, samples=101),
         Parameter("rtol", "real", 1e-9, "integrator rtol = atol (DOPRI5)", low=0.0, low_open=True),
     )
     headline = ("final_attitude_error_rad", "final_position_error_m")
