@@ -250,42 +250,19 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
             where / "position",
             formats,
         )
-        paths += _panels(
-            [
-                (
-                    "ẋ (m/s)",
-                    [("UK slack", t, g["v_uk"], uk), ("direct optimum", t, g["v_direct"], dr)],
-                )
-            ],
-            f"{label}: velocity (cf. Fig. {FIGURES['velocity']})",
-            where / "velocity",
-            formats,
-        )
-        paths += _panels(
-            [
-                (
-                    "u (m/s²)",
-                    [("UK slack", t, g["u_uk"], uk), ("direct optimum", t, g["u_direct"], dr)],
-                )
-            ],
-            f"{label}: control acceleration (cf. Fig. {FIGURES['control']})",
-            where / "control",
-            formats,
-        )
-        paths += _panels(
-            [
-                (
-                    "∫|u| dt (m/s)",
-                    [
-                        ("UK slack", t, _cumulative(np.abs(g["u_uk"]), t), uk),
-                        ("direct optimum", t, _cumulative(np.abs(g["u_direct"]), t), dr),
-                    ],
-                )
-            ],
-            f"{label}: control effort (cf. Fig. {FIGURES['effort']})",
-            where / "effort",
-            formats,
-        )
+        # the UK-slack run beside the optimum: (y label, UK values, optimum's, title, file)
+        effort_uk, effort_d = (_cumulative(np.abs(g[k]), t) for k in ("u_uk", "u_direct"))
+        for ylabel, y_uk, y_d, title, stem in (
+            ("ẋ (m/s)", g["v_uk"], g["v_direct"], "velocity", "velocity"),
+            ("u (m/s²)", g["u_uk"], g["u_direct"], "control acceleration", "control"),
+            ("∫|u| dt (m/s)", effort_uk, effort_d, "control effort", "effort"),
+        ):
+            paths += _panels(
+                [(ylabel, [("UK slack", t, y_uk, uk), ("direct optimum", t, y_d, dr)])],
+                f"{label}: {title} (cf. Fig. {FIGURES[stem]})",
+                where / stem,
+                formats,
+            )
         kkt_uk = d["kkt_uk"].inequalities
         side_color = {"lower": "C2", "upper": "C3"}
         mu_uk = [
