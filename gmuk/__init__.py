@@ -58,6 +58,7 @@ from gmuk.forces import (
     UniformGravity,
 )
 from gmuk.gravity import SphericalHarmonicField
+from gmuk.integrate import compile_loop
 from gmuk.reference import ReferenceState, ReferenceTrajectory
 from gmuk.solvers import UKSolver
 from gmuk.state import Layout, State
@@ -111,6 +112,7 @@ __all__ = [
     "VirtualPairT2",
     "__version__",
     "check",
+    "compile_loop",
     "constraints",
     "control",
     "crosscheck",

@@ -91,6 +91,11 @@ def _parser() -> argparse.ArgumentParser:
         "--samples", type=int, default=1000, help="samples per quantity (default 1000)"
     )
     check.add_argument("--verbose", action="store_true", help="print each row as computed")
+    sub.add_parser(
+        "compile",
+        help="compile the step loop now (once per machine, 10-30 s; runs otherwise compile it "
+        "in the background on first use)",
+    )
     _add_view_parser(sub)
     # issue #16: campaigns (gmuk.campaign._cli parses their arguments)
     sub.add_parser(
@@ -432,6 +437,17 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _check(args)
         if args.command == "view":
             return _view(args)
+        if args.command == "compile":
+            import time
+
+            from gmuk.integrators import _compiled
+
+            start = time.perf_counter()
+            was = _compiled.loaded()
+            _compiled.compile_loop()
+            done = "was already compiled" if was else "compiled"
+            print(f"the step loop {done} ({time.perf_counter() - start:.1f} s)")
+            return 0
         if args.command == "plugins":
             from gmuk.forces import registry
 

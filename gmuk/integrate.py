@@ -64,7 +64,10 @@ from gmuk.trajectory import _ARRAYS, Trajectory
 if TYPE_CHECKING:
     from gmuk.system import Accelerations, System
 
-__all__ = ["METHODS", "simulate"]
+__all__ = ["METHODS", "compile_loop", "simulate"]
+
+#: Compile the step loop now (once per machine); see :func:`simulate`'s ``compiled``.
+compile_loop = _compiled.compile_loop
 
 
 class _Problem:
@@ -349,7 +352,12 @@ def simulate(
         bodies (the "fused" solve) — and the method is DOP853 or a plain tableau; True
         requires it (a :class:`~gmuk.errors.DefinitionError` says why a System does not
         qualify); False always runs the Python loop. Both loops give the same results to
-        rounding (docs/architecture.rst); ``stats["compiled"]`` says which ran. A failure
+        rounding (docs/architecture.rst); ``stats["compiled"]`` says which ran. The loop is
+        compiled once per machine and then loaded from numba's cache: under None, a run
+        that finds it not compiled yet takes the Python loop and starts the compilation in a
+        background process for the runs after it (:func:`compile_loop` compiles it now;
+        ``GMUK_BACKGROUND_COMPILE=0`` turns the background process off), while True
+        compiles it in this process first. A failure
         inside the compiled loop (a field evaluated inside the body, a NaN, a step-size
         underflow, a solve it cannot certify) is retried by the Python loop from the last
         accepted step, which raises the error it always raises, with the trajectory so far.
@@ -430,6 +438,13 @@ def simulate(
         plan = _compiled.program(system, m)
         if compiled and isinstance(plan, str):
             raise DefinitionError(f"this System cannot run compiled: {plan}")
+        if compiled:
+            _compiled.compile_loop()
+        elif not isinstance(plan, str) and not _compiled.loaded(plan):
+            # first use on this machine: compiling takes 10-30 s, more than most runs; this
+            # run takes the Python loop while another process compiles for the next ones
+            _compiled.compile_loop(background=True)
+            plan = "the compiled loop is not compiled yet on this machine"
 
     state0 = state0.replace(t=t0)
     control = runs.current()

@@ -3,6 +3,11 @@ part with a compiled form, mixed and ineligible Systems, failures, stops and res
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import time
+
 import numpy as np
 import pytest
 
@@ -347,3 +352,95 @@ def test_a_constrained_compiled_run_equals_the_python_run():
         np.testing.assert_allclose(fast.multipliers[k], lam, rtol=0, atol=1e-8 * scale)
     np.testing.assert_array_equal(fast.rank, slow.rank)
     assert fast.residual.max() < 1e-9 and slow.residual.max() < 1e-9
+
+
+# ------------------------------------------------------------ compiling once per machine
+def test_every_program_has_the_argument_types_the_loop_is_compiled_for():
+    reference = _compiled.signatures(_compiled._reference_program())
+    systems = [_system(make())[0] for make in CASES.values()]
+    systems += [_pair(None)[0], _pair(gmuk.Baumgarte(0.5, 0.06))[0]]
+    for system in systems:
+        for method in ("DOP853", "DOPRI5", "RK4"):
+            assert _compiled.signatures(_program(system, method)) == reference
+
+
+def test_a_run_before_the_loop_is_compiled_takes_the_python_loop_and_compiles_it_aside(
+    monkeypatch,
+):
+    spawned = []
+    monkeypatch.setattr(_compiled, "loaded", lambda prog=None: False)
+    monkeypatch.setattr(_compiled, "_spawn", lambda: spawned.append(1))
+    system, state = _system([gmuk.PointMassGravity(MU)])
+    first = system.simulate(state, (0.0, 100.0), t_eval=[0.0, 50.0, 100.0])
+    assert not first.stats["compiled"] and spawned == [1]
+    # compiled=True compiles in this process instead (here: already compiled) and runs it
+    forced = system.simulate(state, (0.0, 100.0), t_eval=[0.0, 50.0, 100.0], compiled=True)
+    assert forced.stats["compiled"] and spawned == [1]
+    np.testing.assert_allclose(forced.r_N, first.r_N, rtol=0, atol=1e-13 * R0)
+
+
+def test_the_background_compilation_starts_once_and_not_beside_a_live_one(tmp_path, monkeypatch):
+    started = []
+    monkeypatch.setattr(_compiled.subprocess, "Popen", lambda *a, **k: started.append(a[0]))
+    lock = tmp_path / "compile.lock"
+    monkeypatch.setattr(_compiled, "_lock_path", lambda: lock)
+    monkeypatch.setattr(_compiled, "_spawned", False)
+    monkeypatch.setenv(_compiled.BACKGROUND_ENV, "0")
+    _compiled._spawn()
+    assert started == [] and not lock.exists()  # turned off
+    monkeypatch.delenv(_compiled.BACKGROUND_ENV)
+    monkeypatch.setattr(_compiled, "_spawned", False)
+    lock.touch()  # another process is compiling
+    _compiled._spawn()
+    assert started == []
+    monkeypatch.setattr(_compiled, "_spawned", False)
+    old = time.time() - 2 * _compiled.LOCK_STALE_S
+    os.utime(lock, (old, old))  # that process died long ago
+    _compiled._spawn()
+    assert len(started) == 1 and started[0][1:3] == ["-m", "gmuk.integrators._compiled"]
+    assert lock.exists() and _compiled._lock_held(lock)
+    _compiled._spawn()  # at most once per process
+    assert len(started) == 1
+
+
+def test_a_new_process_loads_the_compiled_loop_from_the_cache_without_compiling():
+    assert _compiled.compile_loop()
+    code = (
+        "import time; from gmuk.integrators import _compiled as c; t = time.perf_counter(); "
+        "ok = c.loaded(); print(ok, time.perf_counter() - t, "
+        "sum(d.stats.cache_misses.get(s, 0) for d in (c.rhs, c.advance) for s in d.overloads))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    ok, seconds, misses = out.stdout.split()
+    assert ok == "True" and misses == "0", out.stdout
+    assert float(seconds) < 5.0  # a load, not a compilation (10-30 s)
+
+
+def test_gmuk_compile_reports_a_loop_already_compiled(capsys):
+    from gmuk.cli import main
+
+    assert main(["compile"]) == 0
+    assert "the step loop was already compiled" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_with_an_empty_cache_the_first_run_is_python_and_a_later_one_compiled(tmp_path):
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba"), "TMPDIR": str(tmp_path)}
+    env.pop(_compiled.BACKGROUND_ENV, None)
+    code = (
+        "import gmuk\n"
+        "s = gmuk.System([gmuk.PointMass('p', 1.0)], [], [gmuk.PointMassGravity(4.9e12)])\n"
+        "x = s.state(r={'p': [2e6, 0, 0]}, v={'p': [0, 1565.0, 0]})\n"
+        "print(s.simulate(x, (0.0, 100.0)).stats['compiled'])\n"
+    )
+    run = [sys.executable, "-c", code]
+    first = subprocess.run(run, env=env, capture_output=True, text=True, check=True)
+    assert first.stdout.split() == ["False"]
+    locks = list(tmp_path.glob("gmuk-compile-*.lock"))
+    assert len(locks) == 1
+    deadline = time.monotonic() + 600
+    while locks[0].exists() and time.monotonic() < deadline:
+        time.sleep(1.0)
+    assert not locks[0].exists()
+    later = subprocess.run(run, env=env, capture_output=True, text=True, check=True)
+    assert later.stdout.split() == ["True"]

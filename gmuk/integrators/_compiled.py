@@ -23,8 +23,16 @@ part.
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
 import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -49,7 +57,7 @@ from gmuk.orbits._kernels import lvlh_state
 if TYPE_CHECKING:
     from gmuk.system import System
 
-__all__ = ["Program", "program"]
+__all__ = ["Program", "compile_loop", "loaded", "program"]
 
 # Status codes of :func:`advance`.
 DONE = 0  #: reached the end time
@@ -137,10 +145,6 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
     nr, ne = lay.n_rigid, lay.n_euclid
     field_data = np.concatenate(fields) if fields else np.zeros(1)
     field_data.setflags(write=False)
-    # The force kernels call the field kernel's one compiled signature (read-only data):
-    # resolving it here loads it (or compiles it once) and keeps the loop from compiling
-    # a second copy for other argument types.
-    _field_kernels.ENTRIES.acceleration_at  # noqa: B018
     parts = (
         np.array(terms, dtype=np.int64).reshape(-1, 8),
         np.array([*params, 0.0], dtype=float),
@@ -173,15 +177,16 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
         ],
         dtype=np.int64,
     )
+    # writable copies: every program has the same argument types (one compiled loop)
     meth = (
-        np.ascontiguousarray(method.A, dtype=float),
-        np.ascontiguousarray(method.b, dtype=float),
-        np.ascontiguousarray(method.c, dtype=float),
-        np.ascontiguousarray(E),
-        np.ascontiguousarray(_tab.E3 if dop853 else np.zeros(method._n_rows)),
-        np.ascontiguousarray(_tab.A),
-        np.ascontiguousarray(_tab.C),
-        np.ascontiguousarray(_tab.D),
+        np.array(method.A, dtype=float, order="C"),
+        np.array(method.b, dtype=float),
+        np.array(method.c, dtype=float),
+        np.array(E, dtype=float),
+        np.array(_tab.E3 if dop853 else np.zeros(method._n_rows), dtype=float),
+        np.array(_tab.A, dtype=float, order="C"),
+        np.array(_tab.C, dtype=float),
+        np.array(_tab.D, dtype=float, order="C"),
         ints,
     )
     return Program(parts, meth, 12 * nr + 2 * ne, int(cons[:, 4].sum()))
@@ -249,7 +254,8 @@ def _constraint_program(system: System) -> tuple[Any, Any, Any]:
         else:
             return f"constraint {c.name!r} has no compiled form", None, None
     solver = system.solver
-    return np.array(rows, dtype=np.int64), np.array([*params, 0.0]), solver._params
+    # a writable copy: every program has the same argument types
+    return np.array(rows, dtype=np.int64), np.array([*params, 0.0]), np.array(solver._params)
 
 
 # ------------------------------------------------------------------------ right-hand side
@@ -835,3 +841,176 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
         fs[F_H] = h
     ints[I_OUT] = out_i
     return status
+
+
+# --------------------------------------------------------------- compiling, once per machine
+#: Set to "0" to keep ``simulate`` from compiling the loop in a background process.
+BACKGROUND_ENV = "GMUK_BACKGROUND_COMPILE"
+#: A background compilation's lock older than this (s) is taken for a dead one's.
+LOCK_STALE_S = 900.0
+_ENTRIES = ("rhs", "initial_step", "advance")
+_spawned = False
+_ready = False  # the loop is compiled or loaded in this process (every program's types)
+
+
+def signatures(prog: Program) -> tuple[tuple[Any, ...], ...]:
+    """The numba argument types of :func:`rhs`, :func:`initial_step` and :func:`advance` as
+    the driver (gmuk.integrate._CompiledStepper) calls them for ``prog``."""
+    from numba import typeof
+
+    f, v = typeof(0.0), typeof(np.empty(1))
+    i = typeof(np.empty(1, dtype=np.int64))
+    G = typeof(np.empty((1, 4, 4)))
+    parts, meth = typeof(prog.parts), typeof(prog.method)
+    return (
+        (f, v, G, parts, v, v),
+        (f, v, G, v, f, f, f, typeof(1), parts, v, i),
+        (parts, meth, v, i, v, G, v, v, v, typeof(True), v, typeof(np.empty((1, 1))),
+         typeof(np.empty((1, 1, 4, 4))), typeof(np.empty((1, 1)))),
+    )  # fmt: skip
+
+
+def _reference_program() -> Program:
+    """The program of a one point mass System: its argument types are every program's."""
+    from gmuk.bodies import PointMass
+    from gmuk.forces.gravity import PointMassGravity
+    from gmuk.system import System
+
+    system = System([PointMass("p", 1.0)], [], [PointMassGravity(1.0)])
+    prog = program(system, DOP853())
+    assert isinstance(prog, Program), prog
+    return prog
+
+
+def loaded(prog: Program | None = None) -> bool:
+    """Whether the loop is compiled for ``prog``'s argument types (all programs share them)
+    in this process, loading it from numba's cache when it is there; never compiles.
+
+    This reads numba's dispatcher internals (its cache and overloads, numba 0.59–0.68);
+    if they change, it answers False and the loop compiles on the next ``compile_loop``."""
+    global _ready
+    if _ready:
+        return True
+    from numba.core.compiler_lock import global_compiler_lock
+
+    sigs = signatures(prog if prog is not None else _reference_program())
+    try:
+        with global_compiler_lock:
+            for name, sig in zip(_ENTRIES, sigs, strict=True):
+                disp = globals()[name]
+                if tuple(sig) in disp.overloads:
+                    continue
+                cres = disp._cache.load_overload(sig, disp.targetctx)
+                if cres is None:
+                    return False
+                disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+                disp.add_overload(cres)
+    except (AttributeError, TypeError):  # numba's internals moved
+        return False
+    _ready = True
+    return True
+
+
+def _lock_path() -> Path:
+    """The lock of a background compilation, one per numba cache folder of this module."""
+    cache = getattr(getattr(advance, "_cache", None), "_cache_path", "") or "no-cache"
+    key = hashlib.sha256(str(cache).encode()).hexdigest()[:16]
+    return Path(tempfile.gettempdir()) / f"gmuk-compile-{key}.lock"
+
+
+def _cacheable() -> bool:
+    return type(getattr(advance, "_cache", None)).__name__ != "NullCache"
+
+
+def compile_loop(*, background: bool = False, timeout: float = 600.0) -> bool:
+    """Compile the step loop once for this machine, or load it from numba's cache.
+
+    Parameters
+    ----------
+    background : bool
+        Start the compilation in a separate process and return at once (False: compile here
+        and return when done, waiting first for a background compilation already running).
+    timeout : float
+        The longest to wait (s) for a background compilation started by another process.
+
+    Returns
+    -------
+    bool
+        Whether the loop is ready in this process.
+    """
+    if loaded():
+        return True
+    if background:
+        _spawn()
+        return False
+    lock = _lock_path()
+    deadline = time.monotonic() + timeout
+    while _lock_held(lock) and time.monotonic() < deadline:
+        time.sleep(0.5)
+        if loaded():
+            return True
+    # The force kernels call the field kernel's one compiled signature (read-only data):
+    # resolving it first loads it (or compiles it once) and keeps the loop from compiling
+    # a second copy for other argument types.
+    _field_kernels.ENTRIES.acceleration_at  # noqa: B018
+    for name, sig in zip(_ENTRIES, signatures(_reference_program()), strict=True):
+        globals()[name].compile(sig)
+    global _ready
+    _ready = True
+    return True
+
+
+def _lock_held(lock: Path) -> bool:
+    try:
+        return time.time() - lock.stat().st_mtime < LOCK_STALE_S
+    except OSError:
+        return False
+
+
+def _spawn() -> None:
+    """Compile the loop in a detached background process, at most once per process and one
+    process per cache folder at a time (a lock file), unless GMUK_BACKGROUND_COMPILE=0 or
+    numba cannot cache (each process would compile again)."""
+    global _spawned
+    if _spawned or os.environ.get(BACKGROUND_ENV, "1") == "0" or not _cacheable():
+        return
+    _spawned = True
+    lock = _lock_path()
+    if _lock_held(lock):
+        return
+    try:
+        lock.unlink(missing_ok=True)  # a stale one
+        fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+    except OSError:
+        return  # another process took it first
+    os.close(fd)
+    try:
+        subprocess.Popen(
+            [sys.executable, "-m", "gmuk.integrators._compiled", str(lock)],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+            close_fds=True,
+        )
+    except OSError:
+        lock.unlink(missing_ok=True)
+
+
+def _main(argv: list[str]) -> int:
+    """The background compilation: compile the loop (numba caches it), then drop the lock."""
+    lock = Path(argv[0]) if argv else None
+    try:
+        with contextlib.suppress(OSError, AttributeError):
+            os.nice(10)  # the user's own runs first
+        compile_loop(timeout=0.0)
+    finally:
+        if lock is not None:
+            lock.unlink(missing_ok=True)
+    return 0
+
+
+if __name__ == "__main__":  # run as a module: compile in the imported module, not __main__
+    from gmuk.integrators import _compiled
+
+    sys.exit(_compiled._main(sys.argv[1:]))
