@@ -73,6 +73,7 @@ def scipy_run(system, state, orbit, ref, rtol, dense):
 
 
 def main() -> None:
+    gmuk.compile_loop()  # timings of the compiled loop, not of its one-time compilation
     orbit, ref, system, state = setup()
     best = {}
     for dense in (False, True):
