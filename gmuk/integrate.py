@@ -435,7 +435,7 @@ def simulate(
         raise DefinitionError(f"compiled must be True, False or None; got {compiled!r}")
     plan: _compiled.Program | str = "not asked for"
     if compiled is None or compiled:
-        plan = _compiled.program(system, m)
+        plan = _compiled.program(system, m, state0)
         if compiled and isinstance(plan, str):
             raise DefinitionError(f"this System cannot run compiled: {plan}")
         if compiled:
@@ -856,6 +856,7 @@ class _CompiledStepper(_Stepper):
                 status = 0 if h > 0 else -1
         p.n_rhs = int(ints[_compiled.I_RHS])
         if status != 0:
+            self._raise_interrupt()
             self._hand_over(state0, t_end, Y, G0, h, ints, outs, rec, max_steps, bar, resume)
             return
         out_arr = np.zeros(0) if outs is None else outs
@@ -886,12 +887,23 @@ class _CompiledStepper(_Stepper):
             if status == _compiled.DONE:
                 return
             if status < 0:
+                self._raise_interrupt()
                 self._hand_over(state0, t_end, Y, G0, h, ints, outs, rec, max_steps, bar, resume)
                 return
             if status == _compiled.FULL and n_out == 0:  # one step has more outputs than room
                 cap = 2 * int(ints[_compiled.I_NEED]) + cap
                 bufs = self._buffers(cap, n, p.layout.n_rigid, n_aux)
             self._after_step()
+
+    def _raise_interrupt(self) -> None:
+        """Re-raise a KeyboardInterrupt (or another non-Exception) that a part evaluated in
+        Python caught from a signal; an Exception is left to the Python loop, which meets
+        it again at the same stage and reports it as it always does."""
+        python = self.program.python
+        if python is not None and python.error is not None:
+            error, python.error = python.error, None
+            if not isinstance(error, Exception):
+                raise error
 
     @staticmethod
     def _buffers(cap: int, n: int, nr: int, n_aux: int) -> _Buffers:

@@ -497,8 +497,16 @@ class System:
             return self._zero_loads, self._zero_loads
         n = self.layout.n_dof
         modeled, unmodeled = np.zeros(n), np.zeros(n)
+        self._add_loads(self._force_plan, state, modeled, unmodeled)
+        return modeled, unmodeled
+
+    def _add_loads(
+        self, plan: list[Any], state: State, modeled: FloatArray, unmodeled: FloatArray
+    ) -> None:
+        """Add the generalized forces of the force models of ``plan`` (entries of
+        ``_force_plan``) at ``state`` to ``modeled`` and ``unmodeled`` (n_dof,)."""
         t = state.t
-        for f, bodies, slots in self._force_plan:
+        for f, bodies, slots in plan:
             target = modeled if f.modeled else unmodeled
             if slots is None:
                 for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
@@ -517,7 +525,6 @@ class System:
                             f"{body.name!r}; expected ({dof},)"
                         )
                 target[offset : offset + dof] += w
-        return modeled, unmodeled
 
     def _force_slot(self, body: Body) -> tuple[Body, bool, int, int, int]:
         s = self.layout.slot(body)

@@ -49,6 +49,52 @@ CASES = {
 }
 
 
+class Drag(gmuk.ForceModel):
+    """A user's force model in Python."""
+
+    def force(self, t, r_N, v_N, body):
+        return -1e-3 * v_N
+
+
+class LoudGravity(gmuk.PointMassGravity):
+    """A built-in model with an overridden method: it has no compiled form."""
+
+    def force(self, t, r_N, v_N, body):
+        return 2.0 * super().force(t, r_N, v_N, body)
+
+
+class RigidDrag(gmuk.ForceModel):
+    """A user's force model on rigid bodies and point masses, unmodeled if asked."""
+
+    def wrench(self, t, g, V, body):
+        return np.r_[-1e-3 * V[:3], -1e-4 * V[3:]]
+
+    def force(self, t, r_N, v_N, body):
+        return -1e-4 * v_N
+
+
+class PairForce(gmuk.ForceModel):
+    """A user's model coupling two bodies (``wrenches``): a weak spring between them."""
+
+    acts_on = frozenset({gmuk.BodyKind.RIGID, gmuk.BodyKind.POINT})
+
+    def wrenches(self, state, bodies):
+        d = state.g[0, :3, 3] - state.x[:3]
+        f = 1e-9 * d
+        return [np.r_[np.zeros(3), -(state.g[0, :3, :3].T @ f)], f]
+
+
+MIXED = {
+    "user force model": lambda: [gmuk.PointMassGravity(MU), RigidDrag()],
+    "overridden built-in": lambda: [LoudGravity(MU), gmuk.GravityGradient(MU, bodies=["sc"])],
+    "coupling model, unmodeled drag": lambda: [
+        gmuk.PointMassGravity(MU),
+        PairForce(["sc", "p"]),
+        RigidDrag(modeled=False),
+    ],
+}
+
+
 def _system(forces):
     sc = gmuk.RigidBody("sc", 500.0, J)
     p = gmuk.PointMass("p", 3.0)
@@ -72,9 +118,9 @@ def _program(system, method="DOP853"):
     return prog
 
 
-@pytest.mark.parametrize("case", sorted(CASES))
+@pytest.mark.parametrize("case", sorted(CASES) + sorted(MIXED))
 def test_the_compiled_right_hand_side_equals_the_python_one_at_random_states(case):
-    system, state = _system(CASES[case]())
+    system, state = _system({**CASES, **MIXED}[case]())
     prog = _program(system)
     problem = integrate._Problem(system)
     rng = np.random.default_rng(7)
@@ -164,25 +210,20 @@ def test_many_outputs_inside_one_step_grow_the_buffers():
     np.testing.assert_allclose(fast.r_N, slow.r_N, rtol=0, atol=1e-13 * R0)
 
 
-class Drag(gmuk.ForceModel):
-    """A user's force model in Python."""
+class OwnAccelerations(gmuk.System):
+    """A System whose accelerations are its own: nothing of it can be compiled."""
 
-    def force(self, t, r_N, v_N, body):
-        return -1e-3 * v_N
-
-
-class LoudGravity(gmuk.PointMassGravity):
-    """A built-in model with an overridden method: it has no compiled form."""
-
-    def force(self, t, r_N, v_N, body):
-        return 2.0 * super().force(t, r_N, v_N, body)
+    def accelerations(self, state):
+        return super().accelerations(state)
 
 
 @pytest.mark.parametrize(
     ("make", "why"),
     [
-        (lambda s: gmuk.System(s.bodies, [], [gmuk.PointMassGravity(MU), Drag()]), "'Drag'"),
-        (lambda s: gmuk.System(s.bodies, [], [LoudGravity(MU)]), "'LoudGravity'"),
+        (
+            lambda s: OwnAccelerations(s.bodies, [], [gmuk.PointMassGravity(MU)]),
+            "overrides accelerations",
+        ),
         (
             lambda s: gmuk.System(
                 s.bodies,
@@ -192,7 +233,7 @@ class LoudGravity(gmuk.PointMassGravity):
             "'fused'",
         ),
     ],
-    ids=["user force model", "overridden built-in", "constraint on a point mass"],
+    ids=["System subclass", "constraint on a point mass"],
 )
 def test_a_system_that_does_not_qualify_runs_the_python_loop_and_says_why(make, why):
     base, _ = _system([])
@@ -209,6 +250,148 @@ def test_a_system_that_does_not_qualify_runs_the_python_loop_and_says_why(make, 
     assert traj.success and not traj.stats["compiled"]
     with pytest.raises(DefinitionError, match=f"cannot run compiled: .*{why}"):
         system.simulate(state, (0.0, 100.0), compiled=True)
+
+
+@pytest.mark.parametrize("case", sorted(MIXED))
+@pytest.mark.parametrize("method", ["DOP853", "RK4"])
+def test_a_system_with_python_parts_runs_compiled_and_equals_the_python_run(case, method):
+    system, state = _system(MIXED[case]())
+    prog = _program(system)
+    assert prog.python is not None and prog.python.forces
+    options = (
+        {"step": 10.0}
+        if method == "RK4"
+        else {"rtol": 1e-11, "atol": 1e-11, "t_eval": np.linspace(0, 3000, 7)}
+    )
+    fast = system.simulate(state, (0.0, 3000.0), method=method, **options)
+    slow = system.simulate(state, (0.0, 3000.0), method=method, compiled=False, **options)
+    assert fast.stats["compiled"] and not slow.stats["compiled"]
+    assert fast.stats["n_rhs"] == slow.stats["n_rhs"]
+    # the right-hand sides agree to rounding (the test above); here Python's loads are added
+    # after the compiled ones, and over 3000 s the runs (rtol 1e-11) drift apart by ~1e-12
+    np.testing.assert_allclose(fast.r_N, slow.r_N, rtol=0, atol=1e-13 * R0)
+    np.testing.assert_allclose(fast.V_B, slow.V_B, rtol=0, atol=1e-11 * V0)
+    np.testing.assert_allclose(fast.xdot, slow.xdot, rtol=0, atol=1e-11 * V0)
+    scale = np.abs(slow.unmodeled_force).max() + np.abs(slow.acceleration).max()
+    np.testing.assert_allclose(
+        fast.unmodeled_force, slow.unmodeled_force, rtol=0, atol=1e-11 * scale
+    )
+
+
+class SpinDamper(gmuk.Constraint):
+    """A user's constraint: the spacecraft's roll rate decays, ω̇₁ = −k ω₁ (one row)."""
+
+    def __init__(self, body, k):
+        super().__init__([body])
+        self.k = k
+
+    def rows(self, state):
+        omega1 = state.twist(self.bodies[0])[0]
+        A = np.zeros((1, 6))
+        A[0, 0] = 1.0
+        return A, np.array([-self.k * omega1])
+
+
+def _pair_and_damper():
+    base, state = _pair(gmuk.Baumgarte(0.5, 0.06))
+    sc = base.bodies[1]
+    damper = SpinDamper(sc, 1e-3)
+    system = gmuk.System(base.bodies, [*base.constraints, damper], base.forces)
+    return system, system.state(
+        g={"virtual": state.g[0], "spacecraft": state.g[1]},
+        V={"virtual": state.V[0], "spacecraft": state.V[1]},
+    )
+
+
+def test_a_user_constraint_among_compiled_ones_runs_compiled_and_equals_the_python_run():
+    system, state = _pair_and_damper()
+    why = _compiled.program(system, get_method("DOP853"))  # the row count is unknown
+    assert why == "constraints without a compiled form need the initial state for their rows"
+    prog = _compiled.program(system, get_method("DOP853"), state)
+    assert isinstance(prog, _compiled.Program) and prog.s == 12
+    assert prog.python is not None and len(prog.python.constraints) == 1
+    t_eval = np.linspace(0.0, 600.0, 13)
+    kw = {"t_eval": t_eval, "rtol": 1e-10, "atol": 1e-10}
+    fast = system.simulate(state, (0.0, 600.0), **kw)
+    slow = system.simulate(state, (0.0, 600.0), compiled=False, **kw)
+    assert fast.stats["compiled"] and not slow.stats["compiled"]
+    assert fast.stats["n_steps"] == slow.stats["n_steps"]
+    np.testing.assert_allclose(fast.g_NB, slow.g_NB, rtol=0, atol=1e-13 * 4e6)
+    np.testing.assert_allclose(fast.V_B, slow.V_B, rtol=0, atol=1e-12 * 1400.0)
+    scale = np.abs(slow.multipliers).max()
+    np.testing.assert_allclose(fast.multipliers, slow.multipliers, rtol=0, atol=1e-6 * scale)
+    # the damper holds: ω₁ of the spacecraft decays as exp(−k t) from its start
+    w1 = fast.V_B[:, 1, 0]
+    np.testing.assert_allclose(w1, w1[0] * np.exp(-1e-3 * t_eval), rtol=1e-6)
+
+
+class FailingDrag(RigidDrag):
+    """A user's model that raises after t = 1000 s (or interrupts, like Ctrl-C)."""
+
+    def __init__(self, error):
+        super().__init__()
+        self.error = error
+
+    def wrench(self, t, g, V, body):
+        if t > 1000.0:
+            raise self.error
+        return super().wrench(t, g, V, body)
+
+
+def test_a_python_part_that_raises_in_the_compiled_loop_fails_as_in_the_python_loop():
+    system, state = _system([gmuk.PointMassGravity(MU), FailingDrag(ValueError("drag table"))])
+    kw = {"t_eval": np.linspace(0, 3000, 31), "rtol": 1e-10, "atol": 1e-10}
+    with pytest.raises(SimulationError, match="ValueError: drag table") as fast:
+        system.simulate(state, (0.0, 3000.0), **kw)
+    with pytest.raises(SimulationError, match="ValueError: drag table") as slow:
+        system.simulate(state, (0.0, 3000.0), compiled=False, **kw)
+    f, s = fast.value.trajectory, slow.value.trajectory
+    assert f.stats["compiled"] and f.status == s.status == "failed"
+    # the same message; the failing step starts where each loop's steps went (their sizes
+    # can differ in the last digits: docs/architecture.rst)
+    t_fast, t_slow = (float(str(e.value).split()[4]) for e in (fast, slow))
+    assert str(fast.value).replace(str(t_fast), "T") == str(slow.value).replace(str(t_slow), "T")
+    assert t_fast == pytest.approx(t_slow, rel=1e-7)
+    np.testing.assert_array_equal(f.t, s.t)
+    assert f.t[-1] == 900.0  # the last output before the failing step
+    np.testing.assert_allclose(f.r_N, s.r_N, rtol=0, atol=1e-13 * R0)
+
+
+def test_an_interrupt_inside_a_python_part_returns_the_trajectory_so_far():
+    system, state = _system([gmuk.PointMassGravity(MU), FailingDrag(KeyboardInterrupt())])
+    kw = {"t_eval": np.linspace(0, 3000, 31), "rtol": 1e-10, "atol": 1e-10}
+    with pytest.warns(gmuk.errors.GmukWarning, match="interrupted"):
+        fast = system.simulate(state, (0.0, 3000.0), **kw)
+    with pytest.warns(gmuk.errors.GmukWarning, match="interrupted"):
+        slow = system.simulate(state, (0.0, 3000.0), compiled=False, **kw)
+    assert fast.status == slow.status == "interrupted" and fast.stats["compiled"]
+    assert 0 < fast.t[-1] <= 1000.0 and fast.t[-1] <= slow.t[-1]
+    np.testing.assert_allclose(fast.r_N, slow.r_N[: len(fast)], rtol=0, atol=1e-13 * R0)
+
+
+class GrowingRows(gmuk.Constraint):
+    """A user's constraint whose row count changes: one row, two (the same one twice)
+    between t = 40 s and 60 s."""
+
+    def rows(self, state):
+        n = 2 if 40.0 < state.t < 60.0 else 1
+        A = np.zeros((n, 6))
+        A[:, 0] = 1.0
+        return A, np.zeros(n)
+
+
+def test_a_constraint_whose_row_count_changes_hands_the_run_to_the_python_loop():
+    base, _ = _system([])
+    system = gmuk.System(base.bodies[:1], [GrowingRows(["sc"])], [gmuk.PointMassGravity(MU)])
+    g = np.eye(4)
+    g[0, 3] = R0
+    state = system.state(g={"sc": g}, V={"sc": [0, 0.01, 0, 0, V0, 0]})
+    kw = {"t_eval": [0.0, 25.0, 100.0], "rtol": 1e-10, "atol": 1e-10}
+    fast = system.simulate(state, (0.0, 100.0), **kw)
+    slow = system.simulate(state, (0.0, 100.0), compiled=False, **kw)
+    assert fast.success and slow.success and fast.stats["compiled"]
+    np.testing.assert_allclose(fast.g_NB, slow.g_NB, rtol=0, atol=1e-13 * R0)
+    np.testing.assert_array_equal(fast.multipliers.shape, (3, 1))
 
 
 def test_compiled_takes_a_bool_or_none():

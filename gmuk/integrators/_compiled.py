@@ -24,6 +24,7 @@ part.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import hashlib
 import math
 import os
@@ -36,6 +37,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
 
 from gmuk._numba import njit
 from gmuk._uk_kernels import relative_rows, rigid_free_accel, tracking_b, uk_rigid
@@ -55,6 +59,7 @@ from gmuk.lie._kernels import (
 from gmuk.orbits._kernels import lvlh_state
 
 if TYPE_CHECKING:
+    from gmuk.state import State
     from gmuk.system import System
 
 __all__ = ["Program", "compile_loop", "loaded", "program"]
@@ -89,6 +94,8 @@ class Program:
     n: int
     #: rows of the stacked constraints
     s: int
+    #: the parts evaluated in Python through the C callback (None: every part is compiled)
+    python: PythonParts | None = None
 
 
 def _generic(method: RungeKuttaMethod) -> bool:
@@ -100,9 +107,13 @@ def _generic(method: RungeKuttaMethod) -> bool:
     )
 
 
-def program(system: System, method: RungeKuttaMethod) -> Program | str:
-    """The compiled form of ``system`` with ``method``, or why there is none (a sentence)."""
-    from gmuk.system import System
+def program(system: System, method: RungeKuttaMethod, state: State | None = None) -> Program | str:
+    """The compiled form of ``system`` with ``method``, or why there is none (a sentence).
+
+    Force models and constraints without a compiled form are evaluated in Python through a
+    C callback (:class:`PythonParts`); the row counts of such constraints are read at
+    ``state`` (the initial state), without which they make the System ineligible."""
+    from gmuk.system import System, _pair
 
     if type(system).accelerations is not System.accelerations:
         return "the System subclass overrides accelerations"
@@ -111,6 +122,21 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
     cons, cparams, uk_params = _constraint_program(system)
     if isinstance(cons, str):
         return cons
+    py_constraints = [k for k in range(cons.shape[0]) if cons[k, 0] == PYTHON]
+    if py_constraints:
+        if state is None:
+            return "constraints without a compiled form need the initial state for their rows"
+        row = 0
+        for k in range(cons.shape[0]):
+            cons[k, 3] = row
+            if cons[k, 0] == PYTHON:
+                c = system.constraints[k]
+                try:
+                    _, b = _pair(c, state)
+                    cons[k, 4] = np.asarray(b).reshape(-1).size
+                except Exception as exc:  # the Python loop reports it
+                    return f"constraint {c.name!r} failed at the initial state ({exc})"
+            row += cons[k, 4]
     if system.controllers:
         return "the System has controllers"
     lay = system.layout
@@ -125,13 +151,15 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
     fields: list[np.ndarray] = []
     field_at: dict[int, tuple[int, int]] = {}
     n_field = 0
-    for f, _bodies, slots in system._force_plan:
-        if slots is None:
-            return f"force model {f.name!r} couples bodies (wrenches)"
-        for body, rigid, index, offset, _dof in slots:
-            term = f._compiled_term(body)
-            if term is None:
-                return f"force model {f.name!r} has no compiled form on body {body.name!r}"
+    py_forces = []
+    for entry in system._force_plan:
+        f, _bodies, slots = entry
+        compiled_terms = [] if slots is None else [f._compiled_term(b) for b, *_ in slots]
+        if slots is None or any(term is None for term in compiled_terms):
+            py_forces.append(entry)  # the whole model in Python
+            continue
+        for (_body, rigid, index, offset, _dof), term in zip(slots, compiled_terms, strict=True):
+            assert term is not None
             code, values, data = term
             f0 = f1 = 0
             if data is not None:
@@ -145,6 +173,13 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
     nr, ne = lay.n_rigid, lay.n_euclid
     field_data = np.concatenate(fields) if fields else np.zeros(1)
     field_data.setflags(write=False)
+    n_rows = int(cons[:, 4].sum())
+    python = None
+    if py_forces or py_constraints:
+        python = PythonParts(system, py_forces, cons, py_constraints)
+    io = python.io if python is not None else np.zeros(1)
+    callback = python.address if python is not None else 0
+    loads_at = python.loads_at if python is not None else 0
     parts = (
         np.array(terms, dtype=np.int64).reshape(-1, 8),
         np.array([*params, 0.0], dtype=float),
@@ -156,12 +191,13 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
         np.asarray(lay.rigid_offsets, dtype=np.int64),
         np.asarray(lay.euclid_offsets, dtype=np.int64),
         np.array(
-            [nr, ne, lay.n_dof, int(system._plant_only_loads), int(cons[:, 4].sum())],
+            [nr, ne, lay.n_dof, int(system._plant_only_loads), n_rows, callback, loads_at],
             dtype=np.int64,
         ),
         cons,
         cparams,
         uk_params,
+        io,
     )
     s = method.n_stages
     E = np.zeros(method._n_rows) if method.E is None else np.asarray(method.E, dtype=float)
@@ -189,12 +225,104 @@ def program(system: System, method: RungeKuttaMethod) -> Program | str:
         np.array(_tab.D, dtype=float, order="C"),
         ints,
     )
-    return Program(parts, meth, 12 * nr + 2 * ne, int(cons[:, 4].sum()))
+    return Program(parts, meth, 12 * nr + 2 * ne, n_rows, python)
+
+
+#: The C signature of PythonParts' callback: int64 f(int64 phase), 0 on success.
+_CALLBACK_TYPE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64)
+
+
+class PythonParts:
+    """The force models and constraints of a System that have no compiled form, evaluated
+    in Python when the compiled right-hand side calls back.
+
+    The compiled loop writes the stage's state into ``io`` and calls a C function (a ctypes
+    callback to :meth:`_call`); this builds the :class:`~gmuk.State`, calls the parts as the
+    System does (``System._add_loads``, each constraint's ``rows``) and writes their
+    generalized forces and rows back into ``io``. Layout of ``io``: t, g (16 n_r), V (6 n_r),
+    x (n_e), ẋ (n_e); from ``loads_at`` the modeled and unmodeled generalized forces
+    (2 n_dof); then for each of these constraints its rows A (rows, n_dof) and b (rows), at
+    the offset the constraint table holds. Only such a part costs Python time; a part that
+    raises makes the loop stop with :data:`CALLBACK` and leaves the exception in ``error``.
+    """
+
+    def __init__(
+        self, system: System, forces: list[Any], cons: np.ndarray, constraints: list[int]
+    ) -> None:
+        lay = system.layout
+        nr, ne, nd = lay.n_rigid, lay.n_euclid, lay.n_dof
+        self.system, self.forces, self.layout = system, forces, lay
+        self._g = slice(1, 1 + 16 * nr)
+        self._V = slice(1 + 16 * nr, 1 + 22 * nr)
+        self._x = slice(1 + 22 * nr, 1 + 22 * nr + ne)
+        self._xd = slice(1 + 22 * nr + ne, 1 + 22 * nr + 2 * ne)
+        self.loads_at = 1 + 22 * nr + 2 * ne
+        at = self.loads_at + 2 * nd
+        self.constraints = []
+        for k in constraints:
+            rows = int(cons[k, 4])
+            cons[k, 5] = at
+            self.constraints.append(
+                (system.constraints[k], system._constraint_cols[k].size,
+                 system._constraint_where[k], rows, at)
+            )  # fmt: skip
+            at += rows * (nd + 1)
+        self.io = np.zeros(at)
+        self._modeled = self.io[self.loads_at : self.loads_at + nd]
+        self._unmodeled = self.io[self.loads_at + nd : self.loads_at + 2 * nd]
+        self._no_z = np.zeros(0)
+        self.error: BaseException | None = None
+        self._c_function = _CALLBACK_TYPE(self._call)  # kept alive with the program
+        self.address = int(ctypes.cast(self._c_function, ctypes.c_void_p).value or 0)
+
+    def _call(self, phase: int) -> int:
+        try:
+            self.evaluate()
+        except BaseException as exc:  # a C caller cannot take an exception: keep it
+            self.error = exc
+            return 1
+        return 0
+
+    def evaluate(self) -> None:
+        """The parts' loads and rows at the state in ``io``, into ``io``."""
+        from gmuk.constraints.base import as_rows
+        from gmuk.errors import ConstraintError
+        from gmuk.state import State
+        from gmuk.system import _pair
+
+        io, lay = self.io, self.layout
+        state = State(
+            float(io[0]),
+            io[self._g].reshape(lay.n_rigid, 4, 4).copy(),
+            io[self._V].reshape(lay.n_rigid, 6).copy(),
+            io[self._x].copy(),
+            io[self._xd].copy(),
+            self._no_z,
+            lay,
+        )
+        if self.forces:
+            self._modeled[:] = 0.0
+            self._unmodeled[:] = 0.0
+            self.system._add_loads(self.forces, state, self._modeled, self._unmodeled)
+        nd = lay.n_dof
+        for c, width, where, rows, at in self.constraints:
+            Ai, bi = _pair(c, state)
+            Ai, bi = as_rows(Ai, bi, width, f"constraint {c.name!r}")
+            if bi.size != rows:
+                raise ConstraintError(
+                    f"constraint {c.name!r} gave {bi.size} rows at t = {state.t:.9g} s and "
+                    f"{rows} at the start"
+                )
+            block = io[at : at + rows * nd].reshape(rows, nd)
+            block[:] = 0.0
+            block[:, where] = Ai.toarray() if hasattr(Ai, "toarray") else Ai
+            io[at + rows * nd : at + rows * (nd + 1)] = bi
 
 
 # Constraint kinds of the compiled right-hand side.
 TRACKING_LVLH = 0  #: ConfigurationTracking of an LVLHReference (Eq. 67), Baumgarte optional
 RELATIVE = 1  #: RelativeConstraint with a zero desired relative motion (Eq. 73)
+PYTHON = 2  #: any other constraint: its rows come from Python (PythonParts), at io[p0:]
 
 
 def _gains(baumgarte: Any, n: int) -> list[float] | None:
@@ -251,8 +379,8 @@ def _constraint_program(system: System) -> tuple[Any, Any, Any]:
             params += [*gains[1 : 1 + S.shape[0]], *S.ravel()]
             rows.append([RELATIVE, idx[0], idx[1], row, S.shape[0], start])
             row += S.shape[0]
-        else:
-            return f"constraint {c.name!r} has no compiled form", None, None
+        else:  # rows from Python; the row count and io offset are set by program()
+            rows.append([PYTHON, idx[0], idx[-1], row, 0, 0])
     solver = system.solver
     # a writable copy: every program has the same argument types
     return np.array(rows, dtype=np.int64), np.array([*params, 0.0]), np.array(solver._params)
@@ -260,6 +388,18 @@ def _constraint_program(system: System) -> tuple[Any, Any, Any]:
 
 # ------------------------------------------------------------------------ right-hand side
 UK_FAILED = -5  #: the fused solve did not certify its answer (the Python loop decides)
+CALLBACK = -6  #: a part evaluated in Python raised (PythonParts.error holds the exception)
+
+
+@intrinsic
+def _call_back(typingctx, address, phase):  # type: ignore[no-untyped-def]
+    """Call the C function ``int64 f(int64 phase)`` at ``address`` (a ctypes callback)."""
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        fnty = ir.FunctionType(ir.IntType(64), [ir.IntType(64)])
+        return builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [args[1]])
+
+    return types.int64(types.int64, types.int64), codegen
 
 
 @njit(cache=True)
@@ -267,8 +407,8 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
     """dY/dt at (t, Y) about the base poses G0 into ``dY``, and into ``aux`` (4 n_dof + s + 1)
     the total acceleration, the unmodeled generalized forces, the constraint acceleration,
     the constraint wrenches M ν̇_c, the multipliers λ (s) and the solve's residual. Returns 0,
-    NONFINITE, UK_FAILED, or −100 − the status of a failed force kernel."""
-    terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims, cons, cparams, P = parts
+    NONFINITE, UK_FAILED, CALLBACK, or −100 − the status of a failed force kernel."""
+    terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims, cons, cparams, P, io = parts
     nr, ne, ndof, plant, s = dims[0], dims[1], dims[2], dims[3], dims[4]
     total = aux[:ndof]
     unmodeled = aux[ndof : 2 * ndof]
@@ -316,11 +456,27 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
         else:
             for i in range(dof):
                 unmodeled[off + i] += w[i]
+    if dims[5] != 0:  # the parts without a compiled form, in Python (PythonParts)
+        io[0] = t
+        for k in range(nr):
+            for a in range(4):
+                for e in range(4):
+                    io[1 + 16 * k + 4 * a + e] = g[k, a, e]
+            for i in range(6):
+                io[1 + 16 * nr + 6 * k + i] = V[k, i]
+        for i in range(2 * ne):
+            io[1 + 22 * nr + i] = Y[x0 + i]
+        if _call_back(dims[5], 0) != 0:
+            return CALLBACK
+        lo = dims[6]
+        for i in range(ndof):
+            modeled[i] += io[lo + i]
+            unmodeled[i] += io[lo + ndof + i]
     if s:
         # rigid bodies only (the fused strategy): the rows, then one compiled UK solve
         A = np.zeros((s, ndof))
         b = np.empty(s)
-        _constraint_rows(t, g, V, cons, cparams, A, b)
+        _constraint_rows(t, g, V, cons, cparams, io, A, b)
         out = np.empty(4 * ndof + s + 3)
         uk_rigid(V, modeled, A, b, P, out)
         if out[4 * ndof + s + 2] != 0.0:
@@ -383,8 +539,9 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _constraint_rows(t, g, V, cons, cparams, A, b):  # type: ignore[no-untyped-def]
-    """The stacked rows (A, b) of the compiled constraints, as their ``rows`` give them."""
+def _constraint_rows(t, g, V, cons, cparams, io, A, b):  # type: ignore[no-untyped-def]
+    """The stacked rows (A, b) of the constraints, as their ``rows`` give them: computed
+    here, or copied from ``io`` where PythonParts wrote them."""
     gd = np.empty((4, 4))
     Vd = np.empty(6)
     Vd_dot = np.empty(6)
@@ -420,6 +577,12 @@ def _constraint_rows(t, g, V, cons, cparams, A, b):  # type: ignore[no-untyped-d
             for r in range(6):
                 A[r0 + r, 6 * i + r] = 1.0
                 b[r0 + r] = bk[r]
+        elif kind == PYTHON:  # A (nrow, n_dof) then b (nrow) at io[p0:]
+            ndof = A.shape[1]
+            for a in range(nrow):
+                for e in range(ndof):
+                    A[r0 + a, e] = io[p0 + a * ndof + e]
+                b[r0 + a] = io[p0 + nrow * ndof + a]
         else:  # RELATIVE: columns [V_L, V_B]
             S = np.empty((nrow, 6))
             for a in range(nrow):
