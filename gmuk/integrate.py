@@ -441,10 +441,13 @@ def simulate(
         if compiled:
             _compiled.compile_loop()
         elif not isinstance(plan, str) and not _compiled.loaded(plan):
-            # first use on this machine: compiling takes 10-30 s, more than most runs; this
-            # run takes the Python loop while another process compiles for the next ones
-            _compiled.compile_loop(background=True)
-            plan = "the compiled loop is not compiled yet on this machine"
+            if _compiled.compile_on_first_use:
+                _compiled.compile_loop()
+            else:
+                # first use on this machine: compiling takes 10-30 s, more than most runs:
+                # this run takes the Python loop while another process compiles the loop
+                _compiled.compile_loop(background=True)
+                plan = "the compiled loop is not compiled yet on this machine"
 
     state0 = state0.replace(t=t0)
     control = runs.current()
@@ -789,11 +792,11 @@ class _CompiledStepper(_Stepper):
             "V_B": bY[:, p.s_V].reshape(n_out, nr, 6).copy(),
             "x": bY[:, p.s_x].copy(),
             "xdot": bY[:, p.s_xd].copy(),
-            "z": np.zeros((n_out, 0)),
+            "z": bY[:, p.s_z].copy(),
             "acceleration": baux[:, :nd].copy(),
             "constraint_acceleration": baux[:, 2 * nd : 3 * nd].copy(),
             "constraint_force": baux[:, 3 * nd : 4 * nd].copy(),
-            "control_force": np.zeros((n_out, nd)),
+            "control_force": baux[:, 4 * nd + s + 1 : 5 * nd + s + 1].copy(),
             "unmodeled_force": baux[:, nd : 2 * nd].copy(),
             "multipliers": baux[:, 4 * nd : 4 * nd + s].copy(),
             "residual": residual,
@@ -811,7 +814,7 @@ class _CompiledStepper(_Stepper):
         resume: dict[str, Any] | None = None,
     ) -> None:
         p, m, prog = self.p, self.method, self.program
-        n, n_dof = p.size, p.layout.n_dof
+        n = p.size
         ints = np.zeros(9, dtype=np.int64)
         h = 0.0
         if resume is not None:
@@ -837,7 +840,7 @@ class _CompiledStepper(_Stepper):
         # the accelerations at the start, in Python: the constant residual and rank of an
         # unconstrained solve, and the first output row exactly as the Python loop makes it
         acc0 = self.p.system._accelerations(p.state(t, Y, G0))
-        n_aux = 4 * n_dof + prog.s + 1
+        n_aux = prog.n_aux
         f0, aux = np.empty(n), np.empty(n_aux)
         ints[_compiled.I_RHS] += 1
         fs = np.array([t, 0.0, t_end, self.rtol, self.atol, self.max_step, 0.0])

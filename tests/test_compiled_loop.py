@@ -136,7 +136,7 @@ def test_the_compiled_right_hand_side_equals_the_python_one_at_random_states(cas
         problem.G0 = G0
         expected = problem.rhs(t, Y)
         acc_py = problem.acc
-        dY, aux = np.empty(problem.size), np.empty(4 * n_dof + 1)
+        dY, aux = np.empty(problem.size), np.empty(prog.n_aux)
         assert _compiled.rhs(t, Y, G0, prog.parts, dY, aux) == 0
         total, unmodeled = aux[:n_dof], aux[n_dof : 2 * n_dof]
         # per 3-vector, to the rounding of its norm
@@ -230,10 +230,10 @@ class OwnAccelerations(gmuk.System):
                 [gmuk.PlaneBound("p", [0.0, 0.0, 1.0], upper=1e7)],
                 [gmuk.PointMassGravity(MU)],
             ),
-            "'fused'",
+            "neither rigid bodies nor point masses",
         ),
     ],
-    ids=["System subclass", "constraint on a point mass"],
+    ids=["System subclass", "slack coordinate of an inequality"],
 )
 def test_a_system_that_does_not_qualify_runs_the_python_loop_and_says_why(make, why):
     base, _ = _system([])
@@ -323,6 +323,92 @@ def test_a_user_constraint_among_compiled_ones_runs_compiled_and_equals_the_pyth
     # the damper holds: ω₁ of the spacecraft decays as exp(−k t) from its start
     w1 = fast.V_B[:, 1, 0]
     np.testing.assert_allclose(w1, w1[0] * np.exp(-1e-3 * t_eval), rtol=1e-6)
+
+
+class Damping(gmuk.Controller):
+    """A user's controller with one internal state that reads the modeled acceleration:
+    rate damping on the rigid body, velocity damping on the point mass, ż = ‖ω‖."""
+
+    uses_modeled_acceleration = True
+
+    def __init__(self):
+        super().__init__(["sc", "p"], n_states=1)
+
+    def control(self, state, z, modeled):
+        omega = state.V[0, :3]
+        u_sc = np.r_[-5.0 * omega, -1e-3 * modeled[3:6]]
+        u_p = -1e-4 * state.xdot[:3] * (1.0 + z[0])
+        return [u_sc, u_p], [np.linalg.norm(omega)]
+
+
+class OnSphere(gmuk.Constraint):
+    """A user's constraint on the point mass: its distance from the origin is constant
+    (ẍ·x + ẋ·ẋ = 0, one row)."""
+
+    def rows(self, state):
+        x, v = state.x[:3], state.xdot[:3]
+        return x[None, :], np.array([-v @ v])
+
+
+def _controlled(constrained):
+    system, state = _system([gmuk.PointMassGravity(MU), RigidDrag(modeled=False)])
+    constraints = [OnSphere(["p"])] if constrained else []
+    system = gmuk.System(system.bodies, constraints, system.forces, [Damping()])
+    return system, system.state(
+        g={"sc": state.g[0]}, V={"sc": state.V[0]}, r={"p": state.x}, v={"p": state.xdot}
+    )
+
+
+@pytest.mark.parametrize("constrained", [False, True], ids=["free", "dense solve"])
+def test_controllers_and_the_dense_solve_run_compiled_and_equal_the_python_run(constrained):
+    system, state = _controlled(constrained)
+    prog = _compiled.program(system, get_method("DOP853"), state)
+    assert isinstance(prog, _compiled.Program), prog
+    assert prog.parts[9][8] == (_compiled.DENSE if constrained else _compiled.FREE)
+    # the right-hand sides at random states, to rounding (a few ulps of each 3-vector)
+    problem = integrate._Problem(system)
+    rng = np.random.default_rng(1)
+    for _ in range(30):
+        Y = problem.pack(state)
+        Y[:6] = rng.normal(scale=[0.1, 0.1, 0.1, 50.0, 50.0, 50.0])
+        Y[6:12] += rng.normal(scale=[0.01, 0.01, 0.01, 5.0, 5.0, 5.0])
+        Y[12:15] += rng.normal(size=3) * 1e3
+        Y[15:18] += rng.normal(size=3)
+        Y[18:] = rng.uniform(size=Y.size - 18)
+        t = float(rng.uniform(0.0, 1e4))
+        problem.G0 = state.g.copy()
+        expected = problem.rhs(t, Y)
+        dY, aux = np.empty(problem.size), np.empty(prog.n_aux)
+        assert _compiled.rhs(t, Y, problem.G0, prog.parts, dY, aux) == 0
+        for blk in range(problem.size // 3):
+            sl = slice(3 * blk, 3 * blk + 3)
+            scale = np.linalg.norm(expected[sl])
+            np.testing.assert_allclose(dY[sl], expected[sl], rtol=0, atol=1e-14 * scale)
+        np.testing.assert_allclose(dY[18:], expected[18:], rtol=1e-15)
+    # Whole runs. Held on the sphere, the point mass's error estimate cancels so deeply that
+    # rounding moves DOP853's step sizes (1e-10 relative by the fourth step, then more):
+    # the constrained run is compared at a fixed step, where the loops take the same steps.
+    kw = {"t_eval": np.linspace(0, 2000, 9), "rtol": 1e-10, "atol": 1e-10}
+    if constrained:
+        kw = {"method": "RK4", "step": 10.0, "t_eval": np.linspace(0, 2000, 9)}
+    fast = system.simulate(state, (0.0, 2000.0), **kw)
+    slow = system.simulate(state, (0.0, 2000.0), compiled=False, **kw)
+    assert fast.stats["compiled"] and not slow.stats["compiled"]
+    assert fast.stats["n_rhs"] == slow.stats["n_rhs"]
+    np.testing.assert_allclose(fast.r_N, slow.r_N, rtol=0, atol=1e-13 * R0)
+    np.testing.assert_allclose(fast.V_B, slow.V_B, rtol=0, atol=1e-11 * V0)
+    np.testing.assert_allclose(fast.z, slow.z, rtol=1e-10, atol=0)
+    for name in ("control_force", "unmodeled_force", "constraint_force", "acceleration"):
+        a, b = getattr(fast, name), getattr(slow, name)
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-9 * np.abs(b).max() + 1e-300)
+    np.testing.assert_allclose(fast.multipliers, slow.multipliers, rtol=1e-8)
+    assert fast.z[-1, 0] > 0.0  # the controller's state integrated ‖ω‖
+    if constrained:  # the modeled accelerations keep the point mass on its sphere: ẍ·x = −ẋ·ẋ
+        plant = (fast.unmodeled_force[:, 6:9] + fast.control_force[:, 6:9]) / 3.0  # on the plant
+        x, v, a = fast.x[:, :3], fast.xdot[:, :3], fast.acceleration[:, 6:9] - plant
+        residual = np.einsum("ij,ij->i", a, x) + np.einsum("ij,ij->i", v, v)
+        scale = np.linalg.norm(a, axis=1) * np.linalg.norm(x, axis=1)
+        assert np.all(np.abs(residual) <= 1e-13 * scale)
 
 
 class FailingDrag(RigidDrag):
@@ -505,7 +591,7 @@ def test_tracking_and_relative_rows_compile_and_match_the_python_solve(baumgarte
         problem.G0 = state.g.copy()
         expected = problem.rhs(t, Y)
         acc = problem.acc
-        dY, aux = np.empty(problem.size), np.empty(4 * nd + prog.s + 1)
+        dY, aux = np.empty(problem.size), np.empty(prog.n_aux)
         assert _compiled.rhs(t, Y, problem.G0, prog.parts, dY, aux) == 0
         np.testing.assert_allclose(dY, expected, rtol=0, atol=1e-15 * np.abs(expected).max())
         lam = aux[4 * nd : 4 * nd + prog.s]
@@ -584,6 +670,38 @@ def test_the_background_compilation_starts_once_and_not_beside_a_live_one(tmp_pa
     assert lock.exists() and _compiled._lock_held(lock)
     _compiled._spawn()  # at most once per process
     assert len(started) == 1
+
+
+def test_compile_on_first_use_compiles_instead_of_taking_the_python_loop(monkeypatch):
+    compiled = []
+    monkeypatch.setattr(_compiled, "loaded", lambda prog=None: False)
+    monkeypatch.setattr(_compiled, "compile_loop", lambda **kw: compiled.append(kw))
+    monkeypatch.setattr(_compiled, "compile_on_first_use", True)
+    system, state = _system([gmuk.PointMassGravity(MU)])
+    traj = system.simulate(state, (0.0, 100.0))
+    assert traj.stats["compiled"] and compiled == [{}]
+
+
+def test_a_compilation_waits_for_another_process_compiling_and_loads_its_result(
+    tmp_path, monkeypatch
+):
+    lock = tmp_path / "compile.lock"
+    lock.write_text("12345")  # another process is compiling
+    monkeypatch.setattr(_compiled, "_lock_path", lambda: lock)
+    answers = iter([False, False, True])  # ...and has finished after two polls
+    monkeypatch.setattr(_compiled, "loaded", lambda prog=None: next(answers))
+    monkeypatch.setattr(_compiled, "_compile_now", lambda: pytest.fail("compiled twice"))
+    monkeypatch.setattr(_compiled.time, "sleep", lambda s: None)
+    assert _compiled.compile_loop() is True
+    assert lock.exists()  # still the other process's to remove
+    # a lock left by a dead process is taken over, and removed after compiling
+    old = time.time() - 2 * _compiled.LOCK_STALE_S
+    os.utime(lock, (old, old))
+    done = []
+    monkeypatch.setattr(_compiled, "loaded", lambda prog=None: False)
+    monkeypatch.setattr(_compiled, "_compile_now", lambda: done.append(lock.read_text()))
+    assert _compiled.compile_loop() is True
+    assert done == [str(os.getpid())] and not lock.exists()
 
 
 def test_a_new_process_loads_the_compiled_loop_from_the_cache_without_compiling():

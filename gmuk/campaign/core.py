@@ -26,6 +26,7 @@ from gmuk.campaign import store as _store
 from gmuk.campaign.dispersions import Dispersion, check_sequence, dispersion_from_dict, magnitude
 from gmuk.campaign.models import CampaignModel, FunctionModel, get_model, model_from_dict
 from gmuk.errors import DefinitionError, GmukError
+from gmuk.integrators import _compiled
 
 __all__ = ["Campaign", "CampaignReport", "resume"]
 
@@ -345,6 +346,10 @@ def execute(campaign: Campaign, k: int, out: str | None) -> dict[str, Any]:
     gives ``status="interrupted"`` (not stored). With ``out``, the worker appends ``start`` and
     ``end`` lines to ``out/attempts.log`` and saves the trajectory when asked.
     """
+    # Every run takes the compiled loop when its System qualifies, compiling it first if
+    # this machine has not (once; workers wait for one another): a run's result must not
+    # depend on when a background compilation ends.
+    _compiled.compile_on_first_use = True
     t0 = time.perf_counter()
     pid = os.getpid()
     _store.log_attempt(out, f"start {k} {pid}")

@@ -42,7 +42,7 @@ from numba import types
 from numba.extending import intrinsic
 
 from gmuk._numba import njit
-from gmuk._uk_kernels import relative_rows, rigid_free_accel, tracking_b, uk_rigid
+from gmuk._uk_kernels import _qr_solve, relative_rows, rigid_free_accel, tracking_b, uk_rigid
 from gmuk.bodies import BodyKind
 from gmuk.forces._kernels import apply_term
 from gmuk.gravity import _kernels as _field_kernels
@@ -97,6 +97,13 @@ class Program:
     #: the parts evaluated in Python through the C callback (None: every part is compiled)
     python: PythonParts | None = None
 
+    @property
+    def n_aux(self) -> int:
+        """Length of :func:`rhs`'s other outputs: total, unmodeled, constraint acceleration,
+        constraint force (n_dof each), λ (s), the residual, the control (n_dof), ż."""
+        dims = self.parts[9]
+        return int(5 * dims[2] + self.s + 1 + dims[6])
+
 
 def _generic(method: RungeKuttaMethod) -> bool:
     cls = type(method)
@@ -113,13 +120,14 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
     Force models and constraints without a compiled form are evaluated in Python through a
     C callback (:class:`PythonParts`); the row counts of such constraints are read at
     ``state`` (the initial state), without which they make the System ineligible."""
+    from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS
     from gmuk.system import System, _pair
 
     if type(system).accelerations is not System.accelerations:
         return "the System subclass overrides accelerations"
     if type(system.solver).__module__ != "gmuk.solvers":
         return f"the solve strategy {type(system.solver).__name__} is not a built-in one"
-    cons, cparams, uk_params = _constraint_program(system)
+    cons, cparams, uk_params, solve = _constraint_program(system)
     if isinstance(cons, str):
         return cons
     py_constraints = [k for k in range(cons.shape[0]) if cons[k, 0] == PYTHON]
@@ -137,8 +145,6 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
                 except Exception as exc:  # the Python loop reports it
                     return f"constraint {c.name!r} failed at the initial state ({exc})"
             row += cons[k, 4]
-    if system.controllers:
-        return "the System has controllers"
     lay = system.layout
     bad = [b.name for b in system.bodies if b.kind not in (BodyKind.RIGID, BodyKind.POINT)]
     if bad:
@@ -174,12 +180,21 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
     field_data = np.concatenate(fields) if fields else np.zeros(1)
     field_data.setflags(write=False)
     n_rows = int(cons[:, 4].sum())
+    if solve == DENSE:  # DenseSolver.solve_rows: QR up to QR_MAX_ROWS rows, certified
+        if n_rows > QR_MAX_ROWS:
+            return f"more than {QR_MAX_ROWS} constraint rows under the dense solve"
+        rcond = system.rcond
+        if rcond is None:
+            rcond = max(n_rows, lay.n_dof) * float(np.finfo(float).eps)
+        uk_params[0] = min(QR_COND_LIMIT, 0.1 / rcond)
+    nc = lay.n_control
     python = None
-    if py_forces or py_constraints:
+    if py_forces or py_constraints or system.controllers:
         python = PythonParts(system, py_forces, cons, py_constraints)
     io = python.io if python is not None else np.zeros(1)
     callback = python.address if python is not None else 0
     loads_at = python.loads_at if python is not None else 0
+    controls_at = python.controls_at if python is not None else 0
     parts = (
         np.array(terms, dtype=np.int64).reshape(-1, 8),
         np.array([*params, 0.0], dtype=float),
@@ -191,7 +206,18 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
         np.asarray(lay.rigid_offsets, dtype=np.int64),
         np.asarray(lay.euclid_offsets, dtype=np.int64),
         np.array(
-            [nr, ne, lay.n_dof, int(system._plant_only_loads), n_rows, callback, loads_at],
+            [
+                nr,
+                ne,
+                lay.n_dof,
+                int(system._plant_only_loads),
+                n_rows,
+                callback,
+                nc,
+                controls_at,
+                solve,
+                loads_at,
+            ],
             dtype=np.int64,
         ),
         cons,
@@ -225,7 +251,7 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
         np.array(_tab.D, dtype=float, order="C"),
         ints,
     )
-    return Program(parts, meth, 12 * nr + 2 * ne, n_rows, python)
+    return Program(parts, meth, 12 * nr + 2 * ne + nc, n_rows, python)
 
 
 #: The C signature of PythonParts' callback: int64 f(int64 phase), 0 on success.
@@ -250,14 +276,20 @@ class PythonParts:
         self, system: System, forces: list[Any], cons: np.ndarray, constraints: list[int]
     ) -> None:
         lay = system.layout
-        nr, ne, nd = lay.n_rigid, lay.n_euclid, lay.n_dof
+        nr, ne, nd, nc = lay.n_rigid, lay.n_euclid, lay.n_dof, lay.n_control
         self.system, self.forces, self.layout = system, forces, lay
+        self.controllers = bool(system.controllers)
         self._g = slice(1, 1 + 16 * nr)
         self._V = slice(1 + 16 * nr, 1 + 22 * nr)
         self._x = slice(1 + 22 * nr, 1 + 22 * nr + ne)
         self._xd = slice(1 + 22 * nr + ne, 1 + 22 * nr + 2 * ne)
-        self.loads_at = 1 + 22 * nr + 2 * ne
-        at = self.loads_at + 2 * nd
+        self._z = slice(1 + 22 * nr + 2 * ne, 1 + 22 * nr + 2 * ne + nc)
+        self.loads_at = 1 + 22 * nr + 2 * ne + nc
+        self.controls_at = self.loads_at + 2 * nd
+        ca = self.controls_at
+        self._acc, self._control = slice(ca, ca + nd), slice(ca + nd, ca + 2 * nd)
+        self._z_dot = slice(ca + 2 * nd, ca + 2 * nd + nc)
+        at = ca + 2 * nd + nc
         self.constraints = []
         for k in constraints:
             rows = int(cons[k, 4])
@@ -270,18 +302,30 @@ class PythonParts:
         self.io = np.zeros(at)
         self._modeled = self.io[self.loads_at : self.loads_at + nd]
         self._unmodeled = self.io[self.loads_at + nd : self.loads_at + 2 * nd]
-        self._no_z = np.zeros(0)
+        self._state: State | None = None
         self.error: BaseException | None = None
         self._c_function = _CALLBACK_TYPE(self._call)  # kept alive with the program
         self.address = int(ctypes.cast(self._c_function, ctypes.c_void_p).value or 0)
 
     def _call(self, phase: int) -> int:
         try:
-            self.evaluate()
+            if phase == 0:
+                self.evaluate()
+            else:
+                self.control()
         except BaseException as exc:  # a C caller cannot take an exception: keep it
             self.error = exc
             return 1
         return 0
+
+    def control(self) -> None:
+        """The controllers' generalized forces and internal-state rates at the state of the
+        last :meth:`evaluate`, given the modeled acceleration in ``io``, into ``io``."""
+        assert self._state is not None
+        io = self.io
+        control, z_dot = self.system._controls(self._state, io[self._acc].copy())
+        io[self._control] = control
+        io[self._z_dot] = z_dot
 
     def evaluate(self) -> None:
         """The parts' loads and rows at the state in ``io``, into ``io``."""
@@ -291,13 +335,13 @@ class PythonParts:
         from gmuk.system import _pair
 
         io, lay = self.io, self.layout
-        state = State(
+        self._state = state = State(
             float(io[0]),
             io[self._g].reshape(lay.n_rigid, 4, 4).copy(),
             io[self._V].reshape(lay.n_rigid, 6).copy(),
             io[self._x].copy(),
             io[self._xd].copy(),
-            self._no_z,
+            io[self._z].copy(),
             lay,
         )
         if self.forces:
@@ -338,32 +382,44 @@ def _gains(baumgarte: Any, n: int) -> list[float] | None:
     return [1.0, *alpha.tolist(), *beta.tolist()]
 
 
-def _constraint_program(system: System) -> tuple[Any, Any, Any]:
+def _constraint_program(system: System) -> tuple[Any, Any, Any, int]:
     """(cons (n_c, 6) int64 — kind, body, other body, first row, rows, parameter start —,
-    parameters, the fused solve's packed constants), or (why not, None, None)."""
+    parameters, the solve's packed constants, the solve: FREE, FUSED or DENSE), or (why
+    not, None, None, 0). The row counts of PYTHON constraints are left to :func:`program`."""
     from gmuk.constraints.relative import RelativeConstraint
     from gmuk.constraints.tracking import ConfigurationTracking
     from gmuk.orbits.lvlh import LVLHReference
-    from gmuk.solvers import FusedRigidSolver
+    from gmuk.solvers import QR_COND_LIMIT, DenseSolver, FusedRigidSolver
 
-    empty = (np.zeros((0, 6), dtype=np.int64), np.zeros(1), np.zeros(1))
+    solver = system.solver
     if not system.constraints:
-        return empty
-    if type(system.solver) is not FusedRigidSolver:
-        return "the System's constraints are solved by another strategy than 'fused'", None, None
+        if not isinstance(solver, DenseSolver):
+            return f"the solve strategy {type(solver).__name__} is not compiled", None, None, 0
+        return np.zeros((0, 6), dtype=np.int64), np.zeros(1), np.zeros(1), FREE
+    if type(solver) is FusedRigidSolver:
+        kind = FUSED
+    elif type(solver) is DenseSolver:
+        kind = DENSE
+    else:
+        why = f"the System's constraints are solved by {type(solver).__name__}, not compiled"
+        return why, None, None, 0
     rows: list[list[int]] = []
     params: list[float] = []
     row = 0
+    rigid = BodyKind.RIGID
     for c in system.constraints:
-        idx = [system.layout.slot(system._resolve(b)).index for b in c.bodies]
+        bodies = [system._resolve(b) for b in c.bodies]
+        idx = [system.layout.slot(b).index for b in bodies]
         start = len(params)
-        if type(c) is ConfigurationTracking and type(c.reference) is LVLHReference:
+        if any(b.kind is not rigid for b in bodies):
+            rows.append([PYTHON, 0, 0, row, 0, 0])  # rows from Python; counts in program()
+        elif type(c) is ConfigurationTracking and type(c.reference) is LVLHReference:
             o = c.reference.orbit
             bg = c.baumgarte
             params += [o.mean_motion, o.e, o.mu, o.p, *np.ravel(c.reference._R_NP)]
             gains = _gains(bg, 6)
             if gains is None:
-                return f"constraint {c.name!r}: Baumgarte gains of another shape", None, None
+                return f"constraint {c.name!r}: Baumgarte gains of another shape", None, None, 0
             params += gains
             rows.append([TRACKING_LVLH, idx[0], idx[0], row, 6, start])
             row += 6
@@ -375,20 +431,28 @@ def _constraint_program(system: System) -> tuple[Any, Any, Any]:
             S = np.asarray(c.S, dtype=float)
             gains = _gains(c.baumgarte, S.shape[0])
             if gains is None:
-                return f"constraint {c.name!r}: Baumgarte gains of another shape", None, None
+                return f"constraint {c.name!r}: Baumgarte gains of another shape", None, None, 0
             params += [*gains[1 : 1 + S.shape[0]], *S.ravel()]
             rows.append([RELATIVE, idx[0], idx[1], row, S.shape[0], start])
             row += S.shape[0]
         else:  # rows from Python; the row count and io offset are set by program()
-            rows.append([PYTHON, idx[0], idx[-1], row, 0, 0])
-    solver = system.solver
-    # a writable copy: every program has the same argument types
-    return np.array(rows, dtype=np.int64), np.array([*params, 0.0]), np.array(solver._params)
+            rows.append([PYTHON, 0, 0, row, 0, 0])
+    cons = np.array(rows, dtype=np.int64)
+    if isinstance(solver, FusedRigidSolver):  # a writable copy: every program has the same argument types
+        return cons, np.array([*params, 0.0]), np.array(solver._params), kind
+    # P[0], the condition limit, depends on the row count: program() sets it
+    P = [QR_COND_LIMIT, system.consistency_tol, *np.ravel(system._Minv_sqrt)]
+    return cons, np.array([*params, 0.0]), np.array(P, dtype=float), kind
 
 
 # ------------------------------------------------------------------------ right-hand side
 UK_FAILED = -5  #: the fused solve did not certify its answer (the Python loop decides)
 CALLBACK = -6  #: a part evaluated in Python raised (PythonParts.error holds the exception)
+
+# How the right-hand side solves (dims[8]).
+FREE = 0  #: no constraints: the free acceleration
+FUSED = 1  #: FusedRigidSolver: free acceleration, QR solve and wrenches in one call
+DENSE = 2  #: DenseSolver: the free acceleration, then the certified QR solve
 
 
 @intrinsic
@@ -404,12 +468,13 @@ def _call_back(typingctx, address, phase):  # type: ignore[no-untyped-def]
 
 @njit(cache=True)
 def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
-    """dY/dt at (t, Y) about the base poses G0 into ``dY``, and into ``aux`` (4 n_dof + s + 1)
+    """dY/dt at (t, Y) about the base poses G0 into ``dY``, and into ``aux`` (Program.n_aux)
     the total acceleration, the unmodeled generalized forces, the constraint acceleration,
-    the constraint wrenches M ν̇_c, the multipliers λ (s) and the solve's residual. Returns 0,
-    NONFINITE, UK_FAILED, CALLBACK, or −100 − the status of a failed force kernel."""
+    the constraint wrenches M ν̇_c, the multipliers λ (s), the solve's residual, the
+    controllers' generalized forces and their states' rates ż. Returns 0, NONFINITE,
+    UK_FAILED, CALLBACK, or −100 − the status of a failed force kernel."""
     terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims, cons, cparams, P, io = parts
-    nr, ne, ndof, plant, s = dims[0], dims[1], dims[2], dims[3], dims[4]
+    nr, ne, ndof, plant, s, nc = dims[0], dims[1], dims[2], dims[3], dims[4], dims[6]
     total = aux[:ndof]
     unmodeled = aux[ndof : 2 * ndof]
     xi = np.empty((nr, 6))
@@ -464,16 +529,17 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
                     io[1 + 16 * k + 4 * a + e] = g[k, a, e]
             for i in range(6):
                 io[1 + 16 * nr + 6 * k + i] = V[k, i]
-        for i in range(2 * ne):
+        for i in range(2 * ne + nc):  # x, ẋ, z
             io[1 + 22 * nr + i] = Y[x0 + i]
         if _call_back(dims[5], 0) != 0:
             return CALLBACK
-        lo = dims[6]
+        lo = dims[9]
         for i in range(ndof):
             modeled[i] += io[lo + i]
             unmodeled[i] += io[lo + ndof + i]
-    if s:
-        # rigid bodies only (the fused strategy): the rows, then one compiled UK solve
+    fused = dims[8] == FUSED
+    if s and fused:
+        # rigid bodies only, every load seen by the solve: the rows, then one compiled call
         A = np.zeros((s, ndof))
         b = np.empty(s)
         _constraint_rows(t, g, V, cons, cparams, io, A, b)
@@ -489,8 +555,6 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
             aux[4 * ndof + i] = out[4 * ndof + i]
         aux[4 * ndof + s] = out[4 * ndof + s]
     else:
-        for i in range(2 * ndof, 4 * ndof + 1):
-            aux[i] = 0.0
         # ν̇_a = M⁻¹(ad*_V 𝕀V + Q): Eq. 10b for rigid bodies, Q/m for point masses
         if nr:
             Q = np.empty((nr, 6))
@@ -503,18 +567,50 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
                     total[r_off[k] + i] = a_r[k, i]
         for i in range(ne):
             total[e_off[i]] = modeled[e_off[i]] / m_e[i]
-        if plant:  # unmodeled loads act on the plant: + M⁻¹ Q_u
-            for k in range(nr):
-                o = r_off[k]
-                for i in range(3):
-                    total[o + i] += (
-                        Jinv[k, i, 0] * unmodeled[o]
-                        + Jinv[k, i, 1] * unmodeled[o + 1]
-                        + Jinv[k, i, 2] * unmodeled[o + 2]
-                    )
-                    total[o + 3 + i] += unmodeled[o + 3 + i] / m_r[k]
-            for i in range(ne):
-                total[e_off[i]] += unmodeled[e_off[i]] / m_e[i]
+        for i in range(2 * ndof, 4 * ndof + s + 1):
+            aux[i] = 0.0
+        if s:  # the dense strategy's QR solve (DenseSolver.solve_rows), certified or handed over
+            A = np.zeros((s, ndof))
+            b = np.empty(s)
+            _constraint_rows(t, g, V, cons, cparams, io, A, b)
+            ac = aux[2 * ndof : 3 * ndof]
+            Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
+            residual, scale, status = _qr_solve(
+                A, b, total, Minv_sqrt, P[0], ac, aux[4 * ndof : 4 * ndof + s]
+            )
+            if status != 0 or residual > P[1] * scale:
+                return UK_FAILED
+            aux[4 * ndof + s] = residual
+            _apply_M(ac, J, m_r, m_e, r_off, e_off, aux[3 * ndof : 4 * ndof])
+            for i in range(ndof):
+                total[i] += ac[i]
+    control = aux[4 * ndof + s + 1 : 5 * ndof + s + 1]
+    z_dot = aux[5 * ndof + s + 1 :]
+    for i in range(ndof):
+        control[i] = 0.0
+    if nc:  # the controllers, in Python, given the modeled acceleration ν̇_a + ν̇_c
+        ca = dims[7]
+        for i in range(ndof):
+            io[ca + i] = total[i]
+        if _call_back(dims[5], 1) != 0:
+            return CALLBACK
+        for i in range(ndof):
+            control[i] = io[ca + ndof + i]
+        for i in range(nc):
+            z_dot[i] = io[ca + 2 * ndof + i]
+    if plant:  # unmodeled loads and controls act on the plant: + M⁻¹ (Q_u + u)
+        for k in range(nr):
+            o = r_off[k]
+            for i in range(3):
+                total[o + i] += (
+                    Jinv[k, i, 0] * (unmodeled[o] + control[o])
+                    + Jinv[k, i, 1] * (unmodeled[o + 1] + control[o + 1])
+                    + Jinv[k, i, 2] * (unmodeled[o + 2] + control[o + 2])
+                )
+                total[o + 3 + i] += (unmodeled[o + 3 + i] + control[o + 3 + i]) / m_r[k]
+        for i in range(ne):
+            o = e_off[i]
+            total[o] += (unmodeled[o] + control[o]) / m_e[i]
     # dY = [dexp⁻¹(ξ) V, V̇, ẋ, ẍ]
     if nr:
         if any_xi:
@@ -532,10 +628,25 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
     for i in range(ne):
         dY[x0 + i] = Y[x0 + ne + i]
         dY[x0 + ne + i] = total[e_off[i]]
+    for i in range(nc):
+        dY[x0 + 2 * ne + i] = z_dot[i]
     for i in range(dY.shape[0]):
         if not math.isfinite(dY[i]):
             return NONFINITE
     return 0
+
+
+@njit(cache=True)
+def _apply_M(a, J, m_r, m_e, r_off, e_off, out):  # type: ignore[no-untyped-def]
+    """out = M a for the block-diagonal mass matrix: [J ω̇; m v̇] per rigid body, m ẍ per
+    point-mass coordinate (System._apply_M)."""
+    for k in range(J.shape[0]):
+        o = r_off[k]
+        for i in range(3):
+            out[o + i] = J[k, i, 0] * a[o] + J[k, i, 1] * a[o + 1] + J[k, i, 2] * a[o + 2]
+            out[o + 3 + i] = m_r[k] * a[o + 3 + i]
+    for i in range(m_e.shape[0]):
+        out[e_off[i]] = m_e[i] * a[e_off[i]]
 
 
 @njit(cache=True)
@@ -681,7 +792,7 @@ def initial_step(t, Y, G0, f0, t_end, first_step, max_step, order, parts, fs, in
     h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
     h0 = min(h0, t_end - t)
     f1 = np.empty(n)
-    aux = np.empty(4 * ndof + parts[9][4] + 1)
+    aux = np.empty(5 * ndof + parts[9][4] + 1 + parts[9][6])
     ints[I_RHS] += 1
     status = rhs(t + h0, Y + h0 * f0, G0, parts, f1, aux)
     if status != 0:
@@ -979,6 +1090,9 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
         for i in range(ne):
             f0[x0 + i] = Y[x0 + ne + i]
             f0[x0 + ne + i] = aux1[parts[8][i]]
+        z_at = 5 * dims[2] + dims[4] + 1  # ż in the outputs of rhs
+        for i in range(dims[6]):
+            f0[x0 + 2 * ne + i] = aux1[z_at + i]
         for i in range(n_aux):
             aux[i] = aux1[i]
         if (not has_outs) or (out_i < n_outs and outs[out_i] == t_new):
@@ -1014,6 +1128,10 @@ LOCK_STALE_S = 900.0
 _ENTRIES = ("rhs", "initial_step", "advance")
 _spawned = False
 _ready = False  # the loop is compiled or loaded in this process (every program's types)
+#: What ``simulate(compiled=None)`` does when the loop is not compiled yet: False (default)
+#: take the Python loop and compile aside; True compile it first (campaign workers, whose
+#: runs must not depend on when the compilation ends).
+compile_on_first_use = False
 
 
 def signatures(prog: Program) -> tuple[tuple[Any, ...], ...]:
@@ -1092,9 +1210,11 @@ def compile_loop(*, background: bool = False, timeout: float = 600.0) -> bool:
     ----------
     background : bool
         Start the compilation in a separate process and return at once (False: compile here
-        and return when done, waiting first for a background compilation already running).
+        and return when done). Either way one process per cache folder compiles at a time
+        (a lock file in the temporary folder); the others wait for it and load its result.
     timeout : float
-        The longest to wait (s) for a background compilation started by another process.
+        The longest to wait (s) for a compilation another process is running; after that,
+        this one compiles too.
 
     Returns
     -------
@@ -1108,10 +1228,23 @@ def compile_loop(*, background: bool = False, timeout: float = 600.0) -> bool:
         return False
     lock = _lock_path()
     deadline = time.monotonic() + timeout
-    while _lock_held(lock) and time.monotonic() < deadline:
+    owned = False
+    while time.monotonic() < deadline:
+        owned = _take(lock)
+        if owned:
+            break
         time.sleep(0.5)
         if loaded():
             return True
+    try:
+        _compile_now()
+    finally:
+        if owned:
+            lock.unlink(missing_ok=True)
+    return True
+
+
+def _compile_now() -> None:
     # The force kernels call the field kernel's one compiled signature (read-only data):
     # resolving it first loads it (or compiles it once) and keeps the loop from compiling
     # a second copy for other argument types.
@@ -1120,6 +1253,20 @@ def compile_loop(*, background: bool = False, timeout: float = 600.0) -> bool:
         globals()[name].compile(sig)
     global _ready
     _ready = True
+
+
+def _take(lock: Path) -> bool:
+    """Create ``lock`` (True), or False while another process holds a live one."""
+    if lock.exists() and not _lock_held(lock):
+        lock.unlink(missing_ok=True)  # a stale one: its process died
+    try:
+        fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+    except FileExistsError:
+        return False
+    except OSError:  # no temporary folder to write in: compile without a lock
+        return True
+    os.write(fd, str(os.getpid()).encode())
+    os.close(fd)
     return True
 
 
@@ -1139,14 +1286,8 @@ def _spawn() -> None:
         return
     _spawned = True
     lock = _lock_path()
-    if _lock_held(lock):
-        return
-    try:
-        lock.unlink(missing_ok=True)  # a stale one
-        fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-    except OSError:
-        return  # another process took it first
-    os.close(fd)
+    if not _take(lock):
+        return  # another process is compiling
     try:
         subprocess.Popen(
             [sys.executable, "-m", "gmuk.integrators._compiled", str(lock)],
@@ -1166,7 +1307,8 @@ def _main(argv: list[str]) -> int:
     try:
         with contextlib.suppress(OSError, AttributeError):
             os.nice(10)  # the user's own runs first
-        compile_loop(timeout=0.0)
+        if not loaded():
+            _compile_now()
     finally:
         if lock is not None:
             lock.unlink(missing_ok=True)
