@@ -325,6 +325,47 @@ def test_a_user_constraint_among_compiled_ones_runs_compiled_and_equals_the_pyth
     np.testing.assert_allclose(w1, w1[0] * np.exp(-1e-3 * t_eval), rtol=1e-6)
 
 
+def _assert_same_right_hand_sides(system, state, prog, n=30):
+    """The compiled and the Python right-hand sides at random states near ``state`` agree to
+    rounding: 1e-14 of each 3-vector's norm, or for an acceleration of the largest of the
+    terms it is formed from (its free acceleration; the constraint solve, whose rounding is
+    relative to its largest entry); 1e-15 relative for the controller states."""
+    problem = integrate._Problem(system)
+    rng = np.random.default_rng(1)
+    for _ in range(n):
+        Y = problem.pack(state)
+        xi = Y[problem.s_xi].reshape(-1, 6)
+        xi[:] = rng.normal(size=xi.shape) * [0.1, 0.1, 0.1, 50.0, 50.0, 50.0]
+        Y[problem.s_V] += rng.normal(size=Y[problem.s_V].size) * 1e-3 * np.abs(Y[problem.s_V])
+        Y[problem.s_x] += rng.normal(size=problem.ne) * 1e3
+        Y[problem.s_xd] += rng.normal(size=problem.ne)
+        Y[problem.s_z] = rng.uniform(size=problem.nc)
+        t = float(rng.uniform(0.0, 1e4))
+        problem.G0 = state.g.copy()
+        expected = problem.rhs(t, Y)
+        dY, aux = np.empty(problem.size), np.empty(prog.n_aux)
+        assert _compiled.rhs(t, Y, problem.G0, prog.parts, dY, aux) == 0
+        acc = problem.acc
+        free = expected.copy()  # the derivative with the free accelerations
+        for k, o in enumerate(system.layout.rigid_offsets):
+            free[problem.s_V.start + 6 * k : problem.s_V.start + 6 * k + 6] = acc.free[o : o + 6]
+        free[problem.s_xd] = acc.free[system.layout.euclid_offsets]
+        solve = np.abs(acc.constraint).max(initial=0.0)
+        end = problem.s_z.start
+        for blk in range(end // 3):
+            sl = slice(3 * blk, 3 * blk + 3)
+            scale = np.linalg.norm(expected[sl])
+            if 3 * blk >= problem.s_V.start and 3 * blk not in range(end)[problem.s_x]:
+                scale = max(scale, np.linalg.norm(free[sl]), solve)
+            np.testing.assert_allclose(dY[sl], expected[sl], rtol=0, atol=1e-14 * scale)
+        np.testing.assert_allclose(dY[end:], expected[end:], rtol=1e-15)
+        nd, s = system.layout.n_dof, prog.s
+        np.testing.assert_allclose(
+            aux[4 * nd : 4 * nd + s], acc.multipliers, rtol=0,
+            atol=1e-13 * np.abs(acc.multipliers).max(initial=1e-300),
+        )  # fmt: skip
+
+
 class Damping(gmuk.Controller):
     """A user's controller with one internal state that reads the modeled acceleration:
     rate damping on the rigid body, velocity damping on the point mass, ż = ‖ω‖."""
@@ -343,11 +384,12 @@ class Damping(gmuk.Controller):
 
 class OnSphere(gmuk.Constraint):
     """A user's constraint on the point mass: its distance from the origin is constant
-    (ẍ·x + ẋ·ẋ = 0, one row)."""
+    (ẍ·x + ẋ·ẋ = 0, one row, divided by ‖x‖)."""
 
     def rows(self, state):
         x, v = state.x[:3], state.xdot[:3]
-        return x[None, :], np.array([-v @ v])
+        r = np.linalg.norm(x)
+        return x[None, :] / r, np.array([-(v @ v) / r])
 
 
 def _controlled(constrained):
@@ -365,26 +407,7 @@ def test_controllers_and_the_dense_solve_run_compiled_and_equal_the_python_run(c
     prog = _compiled.program(system, get_method("DOP853"), state)
     assert isinstance(prog, _compiled.Program), prog
     assert prog.parts[9][8] == (_compiled.DENSE if constrained else _compiled.FREE)
-    # the right-hand sides at random states, to rounding (a few ulps of each 3-vector)
-    problem = integrate._Problem(system)
-    rng = np.random.default_rng(1)
-    for _ in range(30):
-        Y = problem.pack(state)
-        Y[:6] = rng.normal(scale=[0.1, 0.1, 0.1, 50.0, 50.0, 50.0])
-        Y[6:12] += rng.normal(scale=[0.01, 0.01, 0.01, 5.0, 5.0, 5.0])
-        Y[12:15] += rng.normal(size=3) * 1e3
-        Y[15:18] += rng.normal(size=3)
-        Y[18:] = rng.uniform(size=Y.size - 18)
-        t = float(rng.uniform(0.0, 1e4))
-        problem.G0 = state.g.copy()
-        expected = problem.rhs(t, Y)
-        dY, aux = np.empty(problem.size), np.empty(prog.n_aux)
-        assert _compiled.rhs(t, Y, problem.G0, prog.parts, dY, aux) == 0
-        for blk in range(problem.size // 3):
-            sl = slice(3 * blk, 3 * blk + 3)
-            scale = np.linalg.norm(expected[sl])
-            np.testing.assert_allclose(dY[sl], expected[sl], rtol=0, atol=1e-14 * scale)
-        np.testing.assert_allclose(dY[18:], expected[18:], rtol=1e-15)
+    _assert_same_right_hand_sides(system, state, prog)
     # Whole runs. Held on the sphere, the point mass's error estimate cancels so deeply that
     # rounding moves DOP853's step sizes (1e-10 relative by the fourth step, then more):
     # the constrained run is compared at a fixed step, where the loops take the same steps.
@@ -409,6 +432,48 @@ def test_controllers_and_the_dense_solve_run_compiled_and_equal_the_python_run(c
         residual = np.einsum("ij,ij->i", a, x) + np.einsum("ij,ij->i", v, v)
         scale = np.linalg.norm(a, axis=1) * np.linalg.norm(x, axis=1)
         assert np.all(np.abs(residual) <= 1e-13 * scale)
+
+
+def test_compiled_rows_find_rigid_bodies_after_point_masses_under_the_dense_solve():
+    """Point mass first in ν: the tracking and relative rows' columns are at the rigid
+    bodies' offsets; a controller and an unmodeled load make the solve the dense one."""
+    base, pair_state = _pair(gmuk.Baumgarte(0.5, 0.06))
+    p = gmuk.PointMass("p", 3.0)
+    virtual, sc = base.bodies
+    system = gmuk.System(
+        [p, virtual, sc],
+        [*base.constraints, OnSphere([p])],
+        [
+            *base.forces,
+            gmuk.PointMassGravity(MU, bodies=[p]),
+            RigidDrag(bodies=[sc], modeled=False),
+        ],
+        [Rates([sc])],
+    )
+    state = system.state(
+        g={"virtual": pair_state.g[0], "spacecraft": pair_state.g[1]},
+        V={"virtual": pair_state.V[0], "spacecraft": pair_state.V[1]},
+        r={"p": [0.0, R0, 1e3]},
+        v={"p": [-V0, 0.0, 20.0]},
+    )
+    assert system.layout.rigid_offsets.tolist() == [3, 9]
+    prog = _compiled.program(system, get_method("DOP853"), state)
+    assert isinstance(prog, _compiled.Program), prog
+    assert prog.parts[9][8] == _compiled.DENSE and prog.s == 12
+    _assert_same_right_hand_sides(system, state, prog)
+    kw = {"method": "RK4", "step": 5.0, "t_eval": np.linspace(0, 300, 7)}
+    fast = system.simulate(state, (0.0, 300.0), **kw)
+    slow = system.simulate(state, (0.0, 300.0), compiled=False, **kw)
+    assert fast.stats["compiled"] and fast.stats["n_rhs"] == slow.stats["n_rhs"]
+    np.testing.assert_allclose(fast.g_NB, slow.g_NB, rtol=0, atol=1e-13 * 4e6)
+    np.testing.assert_allclose(fast.x, slow.x, rtol=0, atol=1e-13 * R0)
+
+
+class Rates(gmuk.Controller):
+    """A user's rate damper without internal states."""
+
+    def control(self, state, z):
+        return [np.r_[-10.0 * state.twist(self.bodies[0])[:3], np.zeros(3)]], []
 
 
 class FailingDrag(RigidDrag):

@@ -194,7 +194,7 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
     io = python.io if python is not None else np.zeros(1)
     callback = python.address if python is not None else 0
     loads_at = python.loads_at if python is not None else 0
-    controls_at = python.controls_at if python is not None else 0
+    controls_at = python.controls_at if python is not None and system.controllers else 0
     parts = (
         np.array(terms, dtype=np.int64).reshape(-1, 8),
         np.array([*params, 0.0], dtype=float),
@@ -438,7 +438,8 @@ def _constraint_program(system: System) -> tuple[Any, Any, Any, int]:
         else:  # rows from Python; the row count and io offset are set by program()
             rows.append([PYTHON, 0, 0, row, 0, 0])
     cons = np.array(rows, dtype=np.int64)
-    if isinstance(solver, FusedRigidSolver):  # a writable copy: every program has the same argument types
+    if isinstance(solver, FusedRigidSolver):
+        # a writable copy: every program has the same argument types
         return cons, np.array([*params, 0.0]), np.array(solver._params), kind
     # P[0], the condition limit, depends on the row count: program() sets it
     P = [QR_COND_LIMIT, system.consistency_tol, *np.ravel(system._Minv_sqrt)]
@@ -542,7 +543,7 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
         # rigid bodies only, every load seen by the solve: the rows, then one compiled call
         A = np.zeros((s, ndof))
         b = np.empty(s)
-        _constraint_rows(t, g, V, cons, cparams, io, A, b)
+        _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b)
         out = np.empty(4 * ndof + s + 3)
         uk_rigid(V, modeled, A, b, P, out)
         if out[4 * ndof + s + 2] != 0.0:
@@ -572,7 +573,7 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
         if s:  # the dense strategy's QR solve (DenseSolver.solve_rows), certified or handed over
             A = np.zeros((s, ndof))
             b = np.empty(s)
-            _constraint_rows(t, g, V, cons, cparams, io, A, b)
+            _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b)
             ac = aux[2 * ndof : 3 * ndof]
             Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
             residual, scale, status = _qr_solve(
@@ -588,8 +589,8 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
     z_dot = aux[5 * ndof + s + 1 :]
     for i in range(ndof):
         control[i] = 0.0
-    if nc:  # the controllers, in Python, given the modeled acceleration ν̇_a + ν̇_c
-        ca = dims[7]
+    ca = dims[7]
+    if ca:  # the controllers, in Python, given the modeled acceleration ν̇_a + ν̇_c
         for i in range(ndof):
             io[ca + i] = total[i]
         if _call_back(dims[5], 1) != 0:
@@ -650,9 +651,10 @@ def _apply_M(a, J, m_r, m_e, r_off, e_off, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _constraint_rows(t, g, V, cons, cparams, io, A, b):  # type: ignore[no-untyped-def]
+def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[no-untyped-def]
     """The stacked rows (A, b) of the constraints, as their ``rows`` give them: computed
-    here, or copied from ``io`` where PythonParts wrote them."""
+    here (a rigid body's columns start at its offset in ν, ``r_off``), or copied from ``io``
+    where PythonParts wrote them."""
     gd = np.empty((4, 4))
     Vd = np.empty(6)
     Vd_dot = np.empty(6)
@@ -686,7 +688,7 @@ def _constraint_rows(t, g, V, cons, cparams, io, A, b):  # type: ignore[no-untyp
             if cparams[p0 + 13] != 0.0:
                 _baumgarte_tracking(g[i], V[i], gd, Vd, cparams[p0 + 14 :], cparams[p0 + 20 :], bk)
             for r in range(6):
-                A[r0 + r, 6 * i + r] = 1.0
+                A[r0 + r, r_off[i] + r] = 1.0
                 b[r0 + r] = bk[r]
         elif kind == PYTHON:  # A (nrow, n_dof) then b (nrow) at io[p0:]
             ndof = A.shape[1]
@@ -712,8 +714,8 @@ def _constraint_rows(t, g, V, cons, cparams, io, A, b):  # type: ignore[no-untyp
                     bkr[a] = bkr[a] - alpha * q
                 b[r0 + a] = bkr[a]
                 for e in range(6):
-                    A[r0 + a, 6 * i + e] = Ak[a, e]
-                    A[r0 + a, 6 * j + e] = Ak[a, 6 + e]
+                    A[r0 + a, r_off[i] + e] = Ak[a, e]
+                    A[r0 + a, r_off[j] + e] = Ak[a, 6 + e]
 
 
 @njit(cache=True)
