@@ -10,6 +10,12 @@ System (built as ``gmuk.scenarios._lvlh.fully_constrained`` builds it) one right
 ``GravityGradient.wrench``; for a 300 kg point mass in GRGM660PRIM to degree 50 one
 right-hand side and the field's acceleration alone. Medians of 7 batches (µs per call).
 
+Systems with parts in Python (issue #14's mixed systems): a rigid body and a point mass under
+point-mass gravity and a user's Python drag model (3000 s, DOP853 at 1e-11), and the FCCL
+scenario (``gmuk.scenarios.fccl.run()``: the Morse–Lyapunov controller, in Python), each with
+the compiled loop (its Python parts called back) and with the Python loop (the scenario's
+``simulate`` calls forced to it by replacing ``_compiled.program`` for that timing).
+
 Run: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_rhs.py
 """
 
@@ -20,6 +26,7 @@ import os
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+import contextlib
 import itertools
 import math
 import statistics
@@ -62,6 +69,61 @@ def fcei_orbit_run(compiled: bool | None) -> tuple[float, float]:
     return wall, wall / traj.stats["n_rhs"] * 1e6
 
 
+class Drag(gmuk.ForceModel):
+    """A user's force model in Python: linear drag on the twist and on the velocity."""
+
+    def wrench(self, t, g, V, body):  # type: ignore[no-untyped-def]
+        return np.r_[-1e-3 * V[:3], -1e-4 * V[3:]]
+
+    def force(self, t, x, xdot, body):  # type: ignore[no-untyped-def]
+        return -1e-4 * xdot
+
+
+def mixed_run(compiled: bool) -> tuple[float, float]:
+    """Median wall time (s) of the rigid body and point mass with the Python drag model,
+    and µs per RHS."""
+    mu, r0 = 4.9028e12, 1838e3
+    v0 = math.sqrt(mu / r0)
+    sc = gmuk.RigidBody("sc", 500.0, np.diag([150.0, 200.0, 300.0]))
+    p = gmuk.PointMass("p", 3.0)
+    system = gmuk.System([sc, p], [], [gmuk.PointMassGravity(mu), Drag()])
+    g = np.eye(4)
+    g[0, 3] = r0
+    state = system.state(
+        g={"sc": g},
+        V={"sc": [0.01, -0.02, 0.005, 0.0, v0, 0.0]},
+        r={"p": [0.0, r0 + 30e3, 1e3]},
+        v={"p": [-v0, 0.0, 20.0]},
+    )
+    options = {"rtol": 1e-11, "atol": 1e-11, "compiled": compiled}
+    traj = system.simulate(state, (0.0, 3000.0), **options)
+    walls = []
+    for _ in range(7):
+        t0 = time.perf_counter()
+        system.simulate(state, (0.0, 3000.0), **options)
+        walls.append(time.perf_counter() - t0)
+    wall = statistics.median(walls)
+    return wall, wall / traj.stats["n_rhs"] * 1e6
+
+
+def fccl_run(python_loop: bool) -> float:
+    """Median wall time (s) of ``gmuk.scenarios.fccl.run()`` (3 runs after a warm-up)."""
+    from unittest import mock
+
+    from gmuk.integrators import _compiled
+    from gmuk.scenarios import fccl
+
+    force = mock.patch.object(_compiled, "program", lambda *a, **k: "the Python loop, timed")
+    walls = []
+    with force if python_loop else contextlib.nullcontext():
+        fccl.run()
+        for _ in range(3):
+            t0 = time.perf_counter()
+            fccl.run()
+            walls.append(time.perf_counter() - t0)
+    return statistics.median(walls)
+
+
 def main() -> None:
     gmuk.compile_loop()  # timings of the compiled loop, not of its one-time compilation
     fcei.run()
@@ -77,6 +139,17 @@ def main() -> None:
             (f"FCEI orbit, simulate only, {name} (s)", wall),
             (f"FCEI orbit, {name}: µs per right-hand side, whole run", per_rhs),
         ]
+
+    for compiled, name in ((True, "compiled loop"), (False, "Python loop")):
+        wall, per_rhs = mixed_run(compiled)
+        rows += [
+            (f"rigid body + point mass, Python drag model, {name} (s)", wall),
+            (f"same, {name}: µs per right-hand side, whole run", per_rhs),
+        ]
+    rows += [
+        ("gmuk.scenarios.fccl.run(), controller in Python, compiled loop (s)", fccl_run(False)),
+        ("gmuk.scenarios.fccl.run(), Python loop (s)", fccl_run(True)),
+    ]
 
     orbit = fcei_orbit(common.MU)
     craft, ref = common.spacecraft(), LVLHReference(orbit)

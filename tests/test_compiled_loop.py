@@ -741,10 +741,11 @@ def test_compile_on_first_use_compiles_instead_of_taking_the_python_loop(monkeyp
     compiled = []
     monkeypatch.setattr(_compiled, "loaded", lambda prog=None: False)
     monkeypatch.setattr(_compiled, "compile_loop", lambda **kw: compiled.append(kw))
-    monkeypatch.setattr(_compiled, "compile_on_first_use", True)
     system, state = _system([gmuk.PointMassGravity(MU)])
-    traj = system.simulate(state, (0.0, 100.0))
+    with _compiled.compiling_on_first_use():
+        traj = system.simulate(state, (0.0, 100.0))
     assert traj.stats["compiled"] and compiled == [{}]
+    assert _compiled.compile_on_first_use is False  # as it was
 
 
 def test_a_compilation_waits_for_another_process_compiling_and_loads_its_result(

@@ -346,10 +346,6 @@ def execute(campaign: Campaign, k: int, out: str | None) -> dict[str, Any]:
     gives ``status="interrupted"`` (not stored). With ``out``, the worker appends ``start`` and
     ``end`` lines to ``out/attempts.log`` and saves the trajectory when asked.
     """
-    # Every run takes the compiled loop when its System qualifies, compiling it first if
-    # this machine has not (once; workers wait for one another): a run's result must not
-    # depend on when a background compilation ends.
-    _compiled.compile_on_first_use = True
     t0 = time.perf_counter()
     pid = os.getpid()
     _store.log_attempt(out, f"start {k} {pid}")
@@ -365,7 +361,11 @@ def execute(campaign: Campaign, k: int, out: str | None) -> dict[str, Any]:
     params = campaign.parameters(k)
     record |= _flatten(campaign, params)
     try:
-        traj, metrics = campaign.campaign_model.run(params)
+        # Every run takes the compiled loop when its System qualifies, compiling it first if
+        # this machine has not (once; workers wait for one another): a run's result must not
+        # depend on when a background compilation ends.
+        with _compiled.compiling_on_first_use():
+            traj, metrics = campaign.campaign_model.run(params)
         if traj is not None and traj.status != "success":
             record["status"] = traj.status
             record["error"] = traj.message

@@ -1,14 +1,18 @@
 """The compiled step loop: the RKMK integrator of :mod:`gmuk.integrate`, run in machine code
-for a System whose parts all have compiled forms.
+for a System of rigid bodies and point masses.
 
-A System qualifies when it has no controllers, its bodies are rigid bodies and point masses,
-each of its force models gives a compiled term for each of its bodies
-(``ForceModel._compiled_term``: the built-in gravity, uniform-gravity and linear spring–damper
-models, unless a subclass overrides their methods), and it has either no constraints or only
-rigid bodies held by LVLH configuration tracking and relative constraints under the fused
-solve (:func:`_constraint_program`). The method must be one whose step is its
-tableau (every :class:`~gmuk.integrators.RungeKuttaMethod` that keeps the base class's
-``stages``, ``error_norm`` and has no continuous extension of its own) or DOP853 itself.
+The parts that have compiled forms run compiled: the built-in gravity, uniform-gravity and
+linear spring–damper models (``ForceModel._compiled_term``, unless a subclass overrides
+their methods), LVLH configuration tracking and relative constraints on rigid bodies, the
+free acceleration and the Udwadia–Kalaba solve of the ``"fused"`` and ``"dense"`` strategies
+(the certified QR solve; a state whose rows it cannot certify is handed to the Python
+loop). Every other force model, constraint and controller is called in Python from inside
+the loop through a C callback (:class:`PythonParts`): only those parts cost Python time.
+Systems with other bodies (slack coordinates), another solve strategy (sparse, Eq. 80, a
+user's) or a System subclass that overrides ``accelerations`` run the Python loop. The
+method must be one whose step is its tableau (every
+:class:`~gmuk.integrators.RungeKuttaMethod` that keeps the base class's ``stages``,
+``error_norm`` and has no continuous extension of its own) or DOP853 itself.
 :func:`program` derives the compiled form from the parts once per call of ``simulate``; the
 parts stay the objects the user built.
 
@@ -18,7 +22,8 @@ pose update with its Newton–Schulz step, the reuse of the last evaluation's ac
 the step end). It runs a chunk of steps and returns, so that Python can see stop requests,
 write checkpoints and drain the output buffers between chunks; the results agree with the
 Python loop's to rounding (sums in another order), which the tests check on every built-in
-part.
+part. It is compiled once per machine (:func:`compile_loop`) and loaded from numba's cache
+by later processes (:func:`loaded`).
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -392,9 +398,7 @@ def _constraint_program(system: System) -> tuple[Any, Any, Any, int]:
     from gmuk.solvers import QR_COND_LIMIT, DenseSolver, FusedRigidSolver
 
     solver = system.solver
-    if not system.constraints:
-        if not isinstance(solver, DenseSolver):
-            return f"the solve strategy {type(solver).__name__} is not compiled", None, None, 0
+    if not system.constraints:  # every strategy: the free acceleration, then the plant loads
         return np.zeros((0, 6), dtype=np.int64), np.zeros(1), np.zeros(1), FREE
     if type(solver) is FusedRigidSolver:
         kind = FUSED
@@ -1270,6 +1274,18 @@ def _take(lock: Path) -> bool:
     os.write(fd, str(os.getpid()).encode())
     os.close(fd)
     return True
+
+
+@contextlib.contextmanager
+def compiling_on_first_use() -> Iterator[None]:
+    """Within: ``simulate(compiled=None)`` compiles the loop if it is not compiled yet
+    instead of taking the Python loop (:data:`compile_on_first_use`)."""
+    global compile_on_first_use
+    before, compile_on_first_use = compile_on_first_use, True
+    try:
+        yield
+    finally:
+        compile_on_first_use = before
 
 
 def _lock_held(lock: Path) -> bool:
