@@ -476,6 +476,98 @@ class Rates(gmuk.Controller):
         return [np.r_[-10.0 * state.twist(self.bodies[0])[:3], np.zeros(3)]], []
 
 
+class Distance(gmuk.HolonomicConstraint):
+    """|x_sc − x_p| = d (a residual: its rows come from gmuk's finite differences)."""
+
+    def __init__(self, bodies, d, **kw):
+        super().__init__(bodies, fd_length=1e3, fd_time=10.0, **kw)
+        self.d = d
+
+    def residual(self, q, t):
+        g, x = q
+        return np.array([np.linalg.norm(g[:3, 3] - x) - self.d])
+
+
+class NoRoll(gmuk.NonholonomicConstraint):
+    """ω₁ = 0 of the rigid body (a residual in the twist)."""
+
+    def residual(self, q, nu, t):
+        return np.array([nu[0][0]])
+
+
+def _fccl():
+    from gmuk.scenarios import fccl
+
+    system, _, _ = fccl.build(baumgarte=gmuk.Baumgarte(0.5, 0.06))
+    return system, system.state(
+        g={fccl.BODY: fccl.initial_pose()}, V={fccl.BODY: fccl.PRINTED_TWIST}
+    )
+
+
+#: Built-in parts without a compiled form, called back from the compiled loop.
+CALLED_BACK = {
+    "harmonics on the rigid body": lambda: _system(
+        [
+            gmuk.SphericalHarmonicGravity(_spinning_moon(4), bodies=["sc"]),
+            gmuk.PointMassGravity(MU, bodies=["p"]),
+        ]
+    ),
+    "thesis radial harmonics": lambda: _system(
+        [gmuk.ThesisRadialHarmonicGravity(_spinning_moon(4)), gmuk.GravityGradient(MU)]
+    ),
+    "applied wrench, spring-damper": lambda: _system(
+        [
+            gmuk.PointMassGravity(MU),
+            gmuk.AppliedWrench("sc", [1e-3, 0.0, -2e-3, 0.1, 0.0, 0.05]),
+            gmuk.SpringDamper(
+                "sc", [1.0, 0.0, 0.0], "p", [0.0, 0.0, 0.0], stiffness=1e-6, damping=1e-4
+            ),
+        ]
+    ),
+    "holonomic and nonholonomic constraints": lambda: _with_constraints(
+        [Distance(["sc", "p"], np.hypot(R0, R0 + 30e3)), NoRoll(["sc"])]
+    ),
+    "Morse-Lyapunov controller (FCCL)": _fccl,
+}
+
+
+def _with_constraints(constraints):
+    base, state = _system([gmuk.PointMassGravity(MU)])
+    system = gmuk.System(base.bodies, constraints, base.forces)
+    return system, system.state(
+        g={"sc": state.g[0]}, V={"sc": state.V[0]}, r={"p": state.x}, v={"p": state.xdot}
+    )
+
+
+@pytest.mark.parametrize("case", sorted(CALLED_BACK))
+def test_built_in_parts_without_a_compiled_form_run_called_back_as_in_the_python_loop(case):
+    system, state = CALLED_BACK[case]()
+    prog = _compiled.program(system, get_method("RK4"), state)
+    assert isinstance(prog, _compiled.Program), prog
+    assert prog.python is not None
+    _assert_same_right_hand_sides(system, state, prog)
+    kw = {"method": "RK4", "step": 2.0, "t_eval": np.linspace(0.0, 200.0, 5)}
+    fast = system.simulate(state, (0.0, 200.0), **kw)
+    slow = system.simulate(state, (0.0, 200.0), compiled=False, **kw)
+    assert fast.stats["compiled"] and fast.stats["n_rhs"] == slow.stats["n_rhs"]
+    scale = np.abs(slow.g_NB[..., :3, 3]).max()
+    if case == "holonomic and nonholonomic constraints":
+        # Rows by finite differences carry round-off noise (gmuk.constraints.holonomic) that
+        # amplifies any rounding difference, in either loop: the Python loop's own run moves
+        # by about as much (mm over 200 s) when the initial velocity changes by 1e-15.
+        nudged = state.replace(xdot=state.xdot * (1.0 + 1e-15))
+        noise = system.simulate(nudged, (0.0, 200.0), compiled=False, **kw)
+        for name in ("x", "V_B"):
+            ours = np.abs(getattr(fast, name) - getattr(slow, name)).max()
+            theirs = np.abs(getattr(noise, name) - getattr(slow, name)).max()
+            assert 0.0 < theirs and ours <= 10.0 * theirs, (name, ours, theirs)
+        return
+    np.testing.assert_allclose(fast.g_NB, slow.g_NB, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(fast.V_B, slow.V_B, rtol=0, atol=1e-12 * np.abs(slow.V_B).max())
+    np.testing.assert_allclose(fast.x, slow.x, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(fast.z, slow.z, rtol=1e-10, atol=1e-300)
+
+
 class FailingDrag(RigidDrag):
     """A user's model that raises after t = 1000 s (or interrupts, like Ctrl-C)."""
 
