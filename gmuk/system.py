@@ -535,12 +535,17 @@ class System:
         modeled acceleration ν̇_a + ν̇_c (n_dof,), which controllers may ask for."""
         if not self.controllers:
             return self._zero_loads, self._zero_z
+        return self._controls_of(range(len(self.controllers)), state, modeled)
+
+    def _controls_of(
+        self, which: Iterable[int], state: State, modeled: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """:meth:`_controls` of the controllers numbered ``which`` only (ż zero elsewhere)."""
         control = np.zeros(self.layout.n_dof)
         z_dot = np.zeros(self.layout.n_control)
         modeled.setflags(write=False)
-        for c, bodies, sl in zip(
-            self.controllers, self._ctrl_bodies, self._ctrl_slices, strict=True
-        ):
+        for k in which:
+            c, bodies, sl = self.controllers[k], self._ctrl_bodies[k], self._ctrl_slices[k]
             if c.uses_modeled_acceleration:
                 u, zd = c.control(state, state.z[sl], modeled)
             else:

@@ -71,6 +71,11 @@ class Controller(FreezesInSystem, abc.ABC):
         """Label of the controller."""
         return self._name
 
+    def _compiled_term(self) -> tuple[int, FloatArray] | None:
+        """How the compiled step loop evaluates this controller (gmuk.control._kernels: a
+        code and packed parameters), or None when it is called in Python (the default)."""
+        return None
+
     def initial_state(self) -> FloatArray:
         """Initial internal state z(0), shape (n_states,); zeros unless overridden."""
         return np.zeros(self.n_states)

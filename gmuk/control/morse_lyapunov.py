@@ -373,6 +373,39 @@ class MorseLyapunovController(Controller):
             u = u - I @ self._robust_bound(state.t, g, V)
         return [u], psi
 
+    def _compiled_term(self) -> tuple[int, FloatArray] | None:
+        """How the compiled step loop evaluates this law (gmuk.control._kernels): the code
+        and the packed parameters, or None (the thesis variant, a user's bound, a reference
+        other than an LVLHReference, an overridden method) when it is called in Python."""
+        from gmuk.control import _kernels
+        from gmuk.orbits.lvlh import LVLHReference
+
+        cls = MorseLyapunovController
+        if (
+            type(self).control is not cls.control
+            or type(self)._errors is not cls._errors
+            or type(self.reference) is not LVLHReference
+            or self.variant != "corrected"
+            or self.bound is not None
+        ):
+            return None
+        o = self.reference.orbit
+        params = np.concatenate(
+            [
+                [o.mean_motion, o.e, o.mu, o.p],
+                np.ravel(self.reference._R_NP),
+                [self.k11, self.k12],
+                self.k21,
+                self.k22,
+                [self.kappa],
+                self.a,
+                [self.k_integral, float(self.robust), self.kappa2],
+                np.ravel(self._I),
+            ]
+        ).astype(float)
+        assert params.size == _kernels.N_PARAMS
+        return _kernels.MORSE_LYAPUNOV_LVLH, params
+
     def _robust_bound(self, t: float, g: FloatArray, V: FloatArray) -> FloatArray:
         """Eq. 90's κ₂ O/‖r‖⁴, or the user's bound (6,)."""
         if self.bound is not None:

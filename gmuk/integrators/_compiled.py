@@ -50,6 +50,7 @@ from numba.extending import intrinsic
 from gmuk._numba import njit
 from gmuk._uk_kernels import _qr_solve, relative_rows, rigid_free_accel, tracking_b, uk_rigid
 from gmuk.bodies import BodyKind
+from gmuk.control._kernels import apply_control
 from gmuk.forces._kernels import apply_term
 from gmuk.gravity import _kernels as _field_kernels
 from gmuk.integrators import _dop853_tableau as _tab
@@ -194,13 +195,27 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
             rcond = max(n_rows, lay.n_dof) * float(np.finfo(float).eps)
         uk_params[0] = min(QR_COND_LIMIT, 0.1 / rcond)
     nc = lay.n_control
+    ctrl_rows: list[list[int]] = []
+    ctrl_params: list[float] = []
+    py_controllers = []
+    for k, ctl in enumerate(system.controllers):
+        term = ctl._compiled_term()
+        body = system._ctrl_bodies[k][0] if len(system._ctrl_bodies[k]) == 1 else None
+        if term is None or body is None or body.kind is not BodyKind.RIGID:
+            py_controllers.append(k)
+            continue
+        slot = lay.slot(body)
+        code, values = term
+        z0 = int(system._ctrl_slices[k].start)
+        ctrl_rows.append([code, slot.index, slot.offset, z0, len(ctrl_params)])
+        ctrl_params.extend(np.asarray(values, dtype=float).tolist())
     python = None
-    if py_forces or py_constraints or system.controllers:
-        python = PythonParts(system, py_forces, cons, py_constraints)
+    if py_forces or py_constraints or py_controllers:
+        python = PythonParts(system, py_forces, cons, py_constraints, py_controllers)
     io = python.io if python is not None else np.zeros(1)
     callback = python.address if python is not None else 0
     loads_at = python.loads_at if python is not None else 0
-    controls_at = python.controls_at if python is not None and system.controllers else 0
+    controls_at = python.controls_at if python is not None and py_controllers else 0
     parts = (
         np.array(terms, dtype=np.int64).reshape(-1, 8),
         np.array([*params, 0.0], dtype=float),
@@ -230,6 +245,8 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
         cparams,
         uk_params,
         io,
+        np.array(ctrl_rows, dtype=np.int64).reshape(-1, 5),
+        np.array([*ctrl_params, 0.0], dtype=float),
     )
     s = method.n_stages
     E = np.zeros(method._n_rows) if method.E is None else np.asarray(method.E, dtype=float)
@@ -265,8 +282,8 @@ _CALLBACK_TYPE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64)
 
 
 class PythonParts:
-    """The force models and constraints of a System that have no compiled form, evaluated
-    in Python when the compiled right-hand side calls back.
+    """The force models, constraints and controllers of a System that have no compiled form,
+    evaluated in Python when the compiled right-hand side calls back.
 
     The compiled loop writes the stage's state into ``io`` and calls a C function (a ctypes
     callback to :meth:`_call`); this builds the :class:`~gmuk.State`, calls the parts as the
@@ -279,12 +296,17 @@ class PythonParts:
     """
 
     def __init__(
-        self, system: System, forces: list[Any], cons: np.ndarray, constraints: list[int]
+        self,
+        system: System,
+        forces: list[Any],
+        cons: np.ndarray,
+        constraints: list[int],
+        controllers: list[int],
     ) -> None:
         lay = system.layout
         nr, ne, nd, nc = lay.n_rigid, lay.n_euclid, lay.n_dof, lay.n_control
         self.system, self.forces, self.layout = system, forces, lay
-        self.controllers = bool(system.controllers)
+        self.controllers = controllers
         self._g = slice(1, 1 + 16 * nr)
         self._V = slice(1 + 16 * nr, 1 + 22 * nr)
         self._x = slice(1 + 22 * nr, 1 + 22 * nr + ne)
@@ -329,7 +351,9 @@ class PythonParts:
         last :meth:`evaluate`, given the modeled acceleration in ``io``, into ``io``."""
         assert self._state is not None
         io = self.io
-        control, z_dot = self.system._controls(self._state, io[self._acc].copy())
+        control, z_dot = self.system._controls_of(
+            self.controllers, self._state, io[self._acc].copy()
+        )
         io[self._control] = control
         io[self._z_dot] = z_dot
 
@@ -478,7 +502,8 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
     the constraint wrenches M ν̇_c, the multipliers λ (s), the solve's residual, the
     controllers' generalized forces and their states' rates ż. Returns 0, NONFINITE,
     UK_FAILED, CALLBACK, or −100 − the status of a failed force kernel."""
-    terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims, cons, cparams, P, io = parts
+    terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims, cons, cparams, P, io = parts[:14]
+    ctrls, ctrl_params = parts[14], parts[15]
     nr, ne, ndof, plant, s, nc = dims[0], dims[1], dims[2], dims[3], dims[4], dims[6]
     total = aux[:ndof]
     unmodeled = aux[ndof : 2 * ndof]
@@ -603,6 +628,19 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
             control[i] = io[ca + ndof + i]
         for i in range(nc):
             z_dot[i] = io[ca + 2 * ndof + i]
+    if ctrls.shape[0]:  # the compiled controllers (gmuk.control._kernels)
+        u = np.empty(6)
+        zd = np.empty(6)
+        zs = x0 + 2 * ne
+        for c in range(ctrls.shape[0]):
+            code, k, o, z0, p0 = ctrls[c, 0], ctrls[c, 1], ctrls[c, 2], ctrls[c, 3], ctrls[c, 4]
+            apply_control(
+                code, t, g[k], V[k], total[o : o + 6], Y[zs + z0 : zs + z0 + 6],
+                ctrl_params[p0:], u, zd,
+            )  # fmt: skip
+            for i in range(6):
+                control[o + i] += u[i]
+                z_dot[z0 + i] = zd[i]
     if plant:  # unmodeled loads and controls act on the plant: + M⁻¹ (Q_u + u)
         for k in range(nr):
             o = r_off[k]
