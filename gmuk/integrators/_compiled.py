@@ -4,6 +4,7 @@ for a System of rigid bodies and point masses.
 The parts that have compiled forms run compiled: the built-in gravity, uniform-gravity and
 linear spring–damper models (``ForceModel._compiled_term``, unless a subclass overrides
 their methods), LVLH configuration tracking and relative constraints on rigid bodies, the
+corrected Morse–Lyapunov law on an LVLH reference (``Controller._compiled_term``), the
 free acceleration and the Udwadia–Kalaba solve of the ``"fused"`` and ``"dense"`` strategies
 (the certified QR solve; a state whose rows it cannot certify is handed to the Python
 loop). Every other force model, constraint and controller is called in Python from inside
