@@ -137,6 +137,13 @@ def _rotation_failure(
     )
 
 
+def _writable_c(a: FloatArray) -> FloatArray:
+    """``a`` C-contiguous and writable (a copy if needed): the group checks' kernels then
+    compile once, not once more for read-only arrays (a reference's shared poses)."""
+    a = np.ascontiguousarray(a)
+    return a if a.flags.writeable else a.copy()
+
+
 def check_rotation(R: Any, name: str = "R", tol: float = GROUP_TOL) -> FloatArray:
     """Return ``R`` as an array of rotation matrices, or raise :class:`NotOnGroupError`.
 
@@ -146,7 +153,7 @@ def check_rotation(R: Any, name: str = "R", tol: float = GROUP_TOL) -> FloatArra
     from gmuk.lie._kernels import rotation_errors
 
     R = as_array(R, (3, 3), name)
-    flat = np.ascontiguousarray(R.reshape(-1, 3, 3))
+    flat = _writable_c(R.reshape(-1, 3, 3))
     if flat.shape[0] == 0:
         return R
     err, det_err, k = rotation_errors(flat)
@@ -164,7 +171,7 @@ def check_se3(g: Any, name: str = "g", tol: float = GROUP_TOL) -> FloatArray:
     from gmuk.lie._kernels import se3_errors
 
     g = as_array(g, (4, 4), name)
-    flat = np.ascontiguousarray(g.reshape(-1, 4, 4))
+    flat = _writable_c(g.reshape(-1, 4, 4))
     if flat.shape[0] == 0:
         return g
     row_err, err, det_err, k, _ = se3_errors(flat)
