@@ -229,11 +229,12 @@ class OwnAccelerations(gmuk.System):
                 s.bodies,
                 [gmuk.PlaneBound("p", [0.0, 0.0, 1.0], upper=1e7)],
                 [gmuk.PointMassGravity(MU)],
+                sparse=True,
             ),
-            "neither rigid bodies nor point masses",
+            "SparseSolver, not compiled",
         ),
     ],
-    ids=["System subclass", "slack coordinate of an inequality"],
+    ids=["System subclass", "constraints under the sparse solve"],
 )
 def test_a_system_that_does_not_qualify_runs_the_python_loop_and_says_why(make, why):
     base, _ = _system([])
@@ -623,6 +624,28 @@ def test_the_morse_lyapunov_law_runs_compiled_and_equals_the_python_one(law):
     np.testing.assert_allclose(fast.z, slow.z, rtol=0, atol=1e-11 * np.abs(slow.z).max())
     u = np.abs(slow.control_force).max()
     np.testing.assert_allclose(fast.control_force, slow.control_force, rtol=0, atol=1e-10 * u)
+
+
+def test_inequality_constraints_with_slack_coordinates_run_compiled_as_in_the_python_loop():
+    """A point mass kept below a plane by a slack coordinate (Chapter 6), beside a rigid
+    body: the slack's scalar error weight and its Python rows in the compiled loop."""
+    base, state = _system([])
+    bound = gmuk.PlaneBound("p", [0.0, 0.0, 1.0], upper=1.5e3, baumgarte=gmuk.Baumgarte(0.1, 0.01))
+    system = gmuk.System(base.bodies, [bound], [gmuk.PointMassGravity(MU)])
+    state = system.state(
+        g={"sc": state.g[0]}, V={"sc": state.V[0]}, r={"p": state.x}, v={"p": state.xdot}
+    )
+    prog = _compiled.program(system, get_method("DOP853"), state)
+    assert isinstance(prog, _compiled.Program), prog
+    assert system.layout.n_euclid == 4 and prog.parts[16].tolist() == [12, 16]
+    _assert_same_right_hand_sides(system, state, prog)
+    kw = {"t_eval": np.linspace(0.0, 600.0, 7), "rtol": 1e-10, "atol": 1e-10}
+    fast = system.simulate(state, (0.0, 600.0), **kw)
+    slow = system.simulate(state, (0.0, 600.0), compiled=False, **kw)
+    assert fast.stats["compiled"] and fast.stats["n_steps"] == slow.stats["n_steps"]
+    np.testing.assert_allclose(fast.x, slow.x, rtol=0, atol=1e-13 * R0)
+    np.testing.assert_allclose(fast.multipliers, slow.multipliers, rtol=1e-9, atol=1e-300)
+    assert fast.x[:, 2].max() <= 1.5e3 + 1e-6  # below the plane
 
 
 class FailingDrag(RigidDrag):

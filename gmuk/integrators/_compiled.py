@@ -154,9 +154,10 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
                     return f"constraint {c.name!r} failed at the initial state ({exc})"
             row += cons[k, 4]
     lay = system.layout
-    bad = [b.name for b in system.bodies if b.kind not in (BodyKind.RIGID, BodyKind.POINT)]
+    kinds = (BodyKind.RIGID, BodyKind.POINT, BodyKind.SLACK)
+    bad = [b.name for b in system.bodies if b.kind not in kinds]
     if bad:
-        return f"bodies {bad} are neither rigid bodies nor point masses"
+        return f"bodies {bad} are not rigid bodies, point masses or slack coordinates"
     dop853 = type(method) is DOP853
     if not dop853 and not _generic(method):
         return f"the method {type(method).__name__} defines its own step or output"
@@ -217,6 +218,8 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
     callback = python.address if python is not None else 0
     loads_at = python.loads_at if python is not None else 0
     controls_at = python.controls_at if python is not None and py_controllers else 0
+    points = [lay.slot(b).index for b in system.bodies if b.kind is BodyKind.POINT]
+    point_starts = [12 * nr + half * ne + i for half in (0, 1) for i in points]
     parts = (
         np.array(terms, dtype=np.int64).reshape(-1, 8),
         np.array([*params, 0.0], dtype=float),
@@ -248,6 +251,8 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
         io,
         np.array(ctrl_rows, dtype=np.int64).reshape(-1, 5),
         np.array([*ctrl_params, 0.0], dtype=float),
+        # the point masses' 3-vectors in Y (positions, then velocities), for the error weights
+        np.array(point_starts, dtype=np.int64),
     )
     s = method.n_stages
     E = np.zeros(method._n_rows) if method.E is None else np.asarray(method.E, dtype=float)
@@ -791,8 +796,9 @@ def _baumgarte_tracking(g, V, gd, Vd, alpha, beta, b):  # type: ignore[no-untype
 
 
 @njit(cache=True)
-def _scale(Y0, Y1, G0, nr, ne, rtol, atol, sc):  # type: ignore[no-untyped-def]
-    """The error weights of :meth:`gmuk.integrate._Problem.scale`."""
+def _scale(Y0, Y1, G0, nr, pts, rtol, atol, sc):  # type: ignore[no-untyped-def]
+    """The error weights of :meth:`gmuk.integrate._Problem.scale` (``pts``: where the point
+    masses' 3-vectors start in Y; other Euclidean entries are scalars)."""
     for i in range(Y0.shape[0]):
         sc[i] = atol + rtol * max(abs(Y0[i]), abs(Y1[i]))
     for k in range(nr):
@@ -807,7 +813,7 @@ def _scale(Y0, Y1, G0, nr, ne, rtol, atol, sc):  # type: ignore[no-untyped-def]
             w = atol + rtol * max(n0, n1)
             sc[o] = sc[o + 1] = sc[o + 2] = w
     # point masses: positions and velocities as 3-vectors
-    for o in range(12 * nr, 12 * nr + 2 * ne, 3):
+    for o in pts:
         n0 = math.sqrt(Y0[o] ** 2 + Y0[o + 1] ** 2 + Y0[o + 2] ** 2)
         n1 = math.sqrt(Y1[o] ** 2 + Y1[o + 1] ** 2 + Y1[o + 2] ** 2)
         w = atol + rtol * max(n0, n1)
@@ -828,10 +834,10 @@ def initial_step(t, Y, G0, f0, t_end, first_step, max_step, order, parts, fs, in
     step, or a negative number on a failed evaluation (status in ints[I_FIELD])."""
     if first_step > 0.0:
         return min(first_step, t_end - t)
-    nr, ne, ndof = parts[9][0], parts[9][1], parts[9][2]
+    nr, ndof = parts[9][0], parts[9][2]
     n = Y.shape[0]
     sc = np.empty(n)
-    _scale(Y, Y, G0, nr, ne, fs[F_RTOL], fs[F_ATOL], sc)
+    _scale(Y, Y, G0, nr, parts[16], fs[F_RTOL], fs[F_ATOL], sc)
     d0 = _rms(Y, sc)
     d1 = _rms(f0, sc)
     h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
@@ -990,7 +996,7 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
                 K[n_rows - 1, j] = f1[j]
         h_next = h
         if adaptive:
-            _scale(Y, Y1, G0, nr, ne, rtol, atol, sc)
+            _scale(Y, Y1, G0, nr, parts[16], rtol, atol, sc)
             if dop853:
                 n5 = 0.0
                 n3 = 0.0
