@@ -344,23 +344,22 @@ def simulate(
         ``status="failed"`` and the reason in ``message``. A KeyboardInterrupt always returns
         the trajectory so far with ``status="interrupted"`` (and a warning).
     compiled : bool, optional
-        Run the step loop compiled (:mod:`gmuk.integrators._compiled`): None (default) when
-        the System qualifies — rigid bodies and point masses, solved by the ``"fused"`` or
-        ``"dense"`` strategy (or unconstrained) — and the method is DOP853 or a plain
-        tableau; True requires it (a :class:`~gmuk.errors.DefinitionError` says why a
-        System does not qualify); False always runs the Python loop. Built-in force models
-        and the LVLH tracking and relative constraints run compiled; any other force model,
-        constraint or controller is called in Python from inside the compiled loop, and
-        costs only its own Python. Both loops give the same results to rounding
-        (docs/architecture.rst); ``stats["compiled"]`` says which ran. A failure inside the
-        compiled loop (a part that raises, a field evaluated inside the body, a NaN, a
-        step-size underflow, a solve it cannot certify) is retried by the Python loop from
-        the last accepted step, which raises the error it always raises, with the trajectory
-        so far. The loop is compiled once per machine and then loaded from numba's cache:
-        under None, a run that finds it not compiled yet takes the Python loop and starts
-        the compilation in a background process for the runs after it
-        (:func:`compile_loop` compiles it now; ``GMUK_BACKGROUND_COMPILE=0`` turns the
-        background process off), while True compiles it in this process first.
+        Run the step loop compiled (:mod:`gmuk.integrators._compiled`): None (default) when the
+        System qualifies — rigid bodies, point masses and slack coordinates, solved by the
+        ``"fused"`` or ``"dense"`` strategy (or unconstrained) — and the method is DOP853 or a plain
+        tableau; True requires it (a :class:`~gmuk.errors.DefinitionError` says why a System does
+        not qualify); False always runs the Python loop. Built-in force models, the LVLH tracking
+        and relative constraints and the Morse–Lyapunov law run compiled; any other force model,
+        constraint or controller is called in Python from inside the compiled loop, and costs only
+        its own Python. Both loops give the same results to rounding (docs/architecture.rst);
+        ``stats["compiled"]`` says which ran. A failure inside the compiled loop (a part that
+        raises, a field evaluated inside the body, a NaN, a step-size underflow, a solve it cannot
+        certify) is retried by the Python loop from the last accepted step, which raises the error
+        it always raises, with the trajectory so far. The loop is compiled once per machine and then
+        loaded from numba's cache: under None, a run that finds it not compiled yet takes the Python
+        loop and starts the compilation in a background process for the runs after it
+        (:func:`compile_loop` compiles it now; ``GMUK_BACKGROUND_COMPILE=0`` turns the background
+        process off), while True compiles it in this process first.
 
     Returns
     -------

@@ -92,10 +92,15 @@ def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_resu
 
 def test_a_stop_ends_every_simulation_of_a_scenario_and_resume_completes_them(tmp_path):
     out = tmp_path / "three"
-    cmd = _maintenance(out, "10", "--no-plots", "--checkpoint-every", "1")
+    # 20 orbits: the primary run takes about 8 s compiled; the signal comes once it has
+    # written its first checkpoint (after about 1 s of it), well before its end
+    cmd = _maintenance(out, "20", "--no-plots", "--checkpoint-every", "1")
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    time.sleep(6.0)
+    deadline = time.monotonic() + 120.0
+    while not (out / ".checkpoints" / "run-0.npz").exists() and time.monotonic() < deadline:
+        time.sleep(0.1)
     assert proc.poll() is None, proc.communicate()
+    assert not (out / ".checkpoints" / "run-1.npz").exists()  # the primary is still running
     proc.send_signal(signal.SIGTERM)
     _, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 143, stderr

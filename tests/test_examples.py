@@ -25,9 +25,11 @@ CHECKS = {
     ),
     # touches the floor, never goes through it, rests on it with the normal force = weight,
     # and the frictionless floor leaves the horizontal speed alone
+    # Penetration at contact is set by rounding, not by the tolerance: up to 2.1e-9 m over
+    # initial velocities nudged by ±1e-15 to 1e-14 (relative), rtol 1e-10 to 1e-13, either loop
     "inequality_floor.py": lambda r: (
         r["min_height_m"] < 1e-3
-        and r["primal_violation_max_m"] <= 1e-9
+        and r["primal_violation_max_m"] <= 1e-8
         and abs(r["normal_force_vs_weight"]) < 1e-8
         and abs(r["final_horizontal_speed_m_s"] - 0.5) < 1e-9
     ),

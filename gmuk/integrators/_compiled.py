@@ -1,5 +1,5 @@
 """The compiled step loop: the RKMK integrator of :mod:`gmuk.integrate`, run in machine code
-for a System of rigid bodies and point masses.
+for a System of rigid bodies, point masses and slack coordinates.
 
 The parts that have compiled forms run compiled: the built-in gravity, uniform-gravity and
 linear spring–damper models (``ForceModel._compiled_term``, unless a subclass overrides
@@ -9,8 +9,8 @@ free acceleration and the Udwadia–Kalaba solve of the ``"fused"`` and ``"dense
 (the certified QR solve; a state whose rows it cannot certify is handed to the Python
 loop). Every other force model, constraint and controller is called in Python from inside
 the loop through a C callback (:class:`PythonParts`): only those parts cost Python time.
-Systems with other bodies (slack coordinates), another solve strategy (sparse, Eq. 80, a
-user's) or a System subclass that overrides ``accelerations`` run the Python loop. The
+Systems with constraints under another solve strategy (sparse, Eq. 80, a user's) or a
+System subclass that overrides ``accelerations`` run the Python loop. The
 method must be one whose step is its tableau (every
 :class:`~gmuk.integrators.RungeKuttaMethod` that keeps the base class's ``stages``,
 ``error_norm`` and has no continuous extension of its own) or DOP853 itself.
