@@ -434,7 +434,7 @@ def simulate(
         raise DefinitionError(f"compiled must be True, False or None; got {compiled!r}")
     plan: _compiled.Program | str = "not asked for"
     if compiled is None or compiled:
-        plan = _compiled.program(system, m, state0)
+        plan = _compiled.program(system, m, state0.replace(t=t0))
         if compiled and isinstance(plan, str):
             raise DefinitionError(f"this System cannot run compiled: {plan}")
         if compiled:

@@ -138,6 +138,14 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
     cons, cparams, uk_params, solve = _constraint_program(system)
     if isinstance(cons, str):
         return cons
+    lay = system.layout
+    kinds = (BodyKind.RIGID, BodyKind.POINT, BodyKind.SLACK)
+    bad = [b.name for b in system.bodies if b.kind not in kinds]
+    if bad:
+        return f"bodies {bad} are not rigid bodies, point masses or slack coordinates"
+    dop853 = type(method) is DOP853
+    if not dop853 and not _generic(method):
+        return f"the method {type(method).__name__} defines its own step or output"
     py_constraints = [k for k in range(cons.shape[0]) if cons[k, 0] == PYTHON]
     if py_constraints:
         if state is None:
@@ -153,14 +161,6 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
                 except Exception as exc:  # the Python loop reports it
                     return f"constraint {c.name!r} failed at the initial state ({exc})"
             row += cons[k, 4]
-    lay = system.layout
-    kinds = (BodyKind.RIGID, BodyKind.POINT, BodyKind.SLACK)
-    bad = [b.name for b in system.bodies if b.kind not in kinds]
-    if bad:
-        return f"bodies {bad} are not rigid bodies, point masses or slack coordinates"
-    dop853 = type(method) is DOP853
-    if not dop853 and not _generic(method):
-        return f"the method {type(method).__name__} defines its own step or output"
     terms: list[list[int]] = []
     params: list[float] = []
     fields: list[np.ndarray] = []
@@ -292,13 +292,16 @@ class PythonParts:
     evaluated in Python when the compiled right-hand side calls back.
 
     The compiled loop writes the stage's state into ``io`` and calls a C function (a ctypes
-    callback to :meth:`_call`); this builds the :class:`~gmuk.State`, calls the parts as the
-    System does (``System._add_loads``, each constraint's ``rows``) and writes their
-    generalized forces and rows back into ``io``. Layout of ``io``: t, g (16 n_r), V (6 n_r),
-    x (n_e), ẋ (n_e); from ``loads_at`` the modeled and unmodeled generalized forces
-    (2 n_dof); then for each of these constraints its rows A (rows, n_dof) and b (rows), at
-    the offset the constraint table holds. Only such a part costs Python time; a part that
-    raises makes the loop stop with :data:`CALLBACK` and leaves the exception in ``error``.
+    callback to :meth:`_call`): in phase 0 this builds the :class:`~gmuk.State`, calls the
+    force models and constraints as the System does (``System._add_loads``, each
+    constraint's ``rows``) and writes their generalized forces and rows back into ``io``; in
+    phase 1, after the solve, it calls the controllers with the modeled acceleration
+    (``System._controls_of``). Layout of ``io``: t, g (16 n_r), V (6 n_r), x (n_e), ẋ (n_e),
+    z (n_c); from ``loads_at`` the modeled and unmodeled generalized forces (2 n_dof); from
+    ``controls_at`` the modeled acceleration (n_dof, in), the controls (n_dof) and ż (n_c);
+    then for each of these constraints its rows A (rows, n_dof) and b (rows), at the offset
+    the constraint table holds. Only such a part costs Python time; a part that raises makes
+    the loop stop with :data:`CALLBACK` and leaves the exception in ``error``.
     """
 
     def __init__(
@@ -421,7 +424,8 @@ def _gains(baumgarte: Any, n: int) -> list[float] | None:
 def _constraint_program(system: System) -> tuple[Any, Any, Any, int]:
     """(cons (n_c, 6) int64 — kind, body, other body, first row, rows, parameter start —,
     parameters, the solve's packed constants, the solve: FREE, FUSED or DENSE), or (why
-    not, None, None, 0). The row counts of PYTHON constraints are left to :func:`program`."""
+    not, None, None, 0) for a solve strategy that is not compiled. The row counts of PYTHON
+    constraints are left to :func:`program`."""
     from gmuk.constraints.relative import RelativeConstraint
     from gmuk.constraints.tracking import ConfigurationTracking
     from gmuk.orbits.lvlh import LVLHReference
@@ -445,32 +449,29 @@ def _constraint_program(system: System) -> tuple[Any, Any, Any, int]:
         bodies = [system._resolve(b) for b in c.bodies]
         idx = [system.layout.slot(b).index for b in bodies]
         start = len(params)
-        if any(b.kind is not rigid for b in bodies):
-            rows.append([PYTHON, 0, 0, row, 0, 0])  # rows from Python; counts in program()
-        elif type(c) is ConfigurationTracking and type(c.reference) is LVLHReference:
-            o = c.reference.orbit
-            bg = c.baumgarte
-            params += [o.mean_motion, o.e, o.mu, o.p, *np.ravel(c.reference._R_NP)]
-            gains = _gains(bg, 6)
-            if gains is None:
-                return f"constraint {c.name!r}: Baumgarte gains of another shape", None, None, 0
-            params += gains
-            rows.append([TRACKING_LVLH, idx[0], idx[0], row, 6, start])
-            row += 6
-        elif (
+        tracking = type(c) is ConfigurationTracking and type(c.reference) is LVLHReference
+        relative = (
             type(c) is RelativeConstraint
             and c.acceleration is None
             and (c.baumgarte is None or c.velocity is None)
-        ):
+        )
+        gains = None
+        if tracking or relative:
+            gains = _gains(c.baumgarte, 6 if tracking else np.asarray(c.S).shape[0])
+        if gains is None or any(b.kind is not rigid for b in bodies):
+            # rows from Python (another kind, or Baumgarte gains of a shape the kernels do
+            # not take); program() sets their count and place
+            rows.append([PYTHON, 0, 0, row, 0, 0])
+        elif tracking:
+            o = c.reference.orbit
+            params += [o.mean_motion, o.e, o.mu, o.p, *np.ravel(c.reference._R_NP), *gains]
+            rows.append([TRACKING_LVLH, idx[0], idx[0], row, 6, start])
+            row += 6
+        else:
             S = np.asarray(c.S, dtype=float)
-            gains = _gains(c.baumgarte, S.shape[0])
-            if gains is None:
-                return f"constraint {c.name!r}: Baumgarte gains of another shape", None, None, 0
             params += [*gains[1 : 1 + S.shape[0]], *S.ravel()]
             rows.append([RELATIVE, idx[0], idx[1], row, S.shape[0], start])
             row += S.shape[0]
-        else:  # rows from Python; the row count and io offset are set by program()
-            rows.append([PYTHON, 0, 0, row, 0, 0])
     cons = np.array(rows, dtype=np.int64)
     if isinstance(solver, FusedRigidSolver):
         # a writable copy: every program has the same argument types
