@@ -291,6 +291,21 @@ def _dispersed_twist(g_ref: np.ndarray, V_ref: np.ndarray, g: np.ndarray, dv_N: 
     return np.concatenate([V_ref[:3], g[:3, :3].T @ v_N])
 
 
+def _error_metrics(t: np.ndarray, pos: np.ndarray, att: np.ndarray) -> dict[str, float]:
+    """Initial, final and largest position (m) and attitude (rad) errors against the
+    reference, and their settling times (s), at output times ``t``."""
+    return {
+        "initial_position_error_m": float(pos[0]),
+        "initial_attitude_error_rad": float(att[0]),
+        "final_position_error_m": float(pos[-1]),
+        "final_attitude_error_rad": float(att[-1]),
+        "max_position_error_m": float(pos.max()),
+        "max_attitude_error_rad": float(att.max()),
+        "position_settling_time_s": _settling_time(t, pos),
+        "attitude_settling_time_s": _settling_time(t, att),
+    }
+
+
 def _settling_time(t: np.ndarray, err: np.ndarray, fraction: float = 0.02) -> float:
     """First time after which ``err`` stays ≤ ``fraction`` of its initial value (s); NaN if it
     never settles within the run."""
@@ -396,14 +411,7 @@ class _LVLHModel(CampaignModel):
         f = np.linalg.norm(view.constraint_force[:, 3:], axis=1)
         L = np.linalg.norm(view.constraint_force[:, :3], axis=1)
         return {
-            "initial_position_error_m": float(pos[0]),
-            "initial_attitude_error_rad": float(att[0]),
-            "final_position_error_m": float(pos[-1]),
-            "final_attitude_error_rad": float(att[-1]),
-            "max_position_error_m": float(pos.max()),
-            "max_attitude_error_rad": float(att.max()),
-            "position_settling_time_s": _settling_time(traj.t, pos),
-            "attitude_settling_time_s": _settling_time(traj.t, att),
+            **_error_metrics(traj.t, pos, att),
             "peak_constraint_force_N": float(f.max()),
             "peak_constraint_torque_N_m": float(L.max()),
         }
@@ -629,14 +637,7 @@ class FCCLModel(CampaignModel):
         pos, att = common.reference_errors(traj, orbit, fccl.BODY)
         u = traj.body(fccl.BODY).control_force
         metrics = {
-            "initial_position_error_m": float(pos[0]),
-            "initial_attitude_error_rad": float(att[0]),
-            "final_position_error_m": float(pos[-1]),
-            "final_attitude_error_rad": float(att[-1]),
-            "max_position_error_m": float(pos.max()),
-            "max_attitude_error_rad": float(att.max()),
-            "position_settling_time_s": _settling_time(traj.t, pos),
-            "attitude_settling_time_s": _settling_time(traj.t, att),
+            **_error_metrics(traj.t, pos, att),
             "peak_control_torque_N_m": float(np.linalg.norm(u[:, :3], axis=1).max()),
             "peak_control_force_N": float(np.linalg.norm(u[:, 3:], axis=1).max()),
         }
