@@ -52,6 +52,7 @@ from gmuk._numba import njit
 from gmuk._uk_kernels import _qr_solve, relative_rows, rigid_free_accel, tracking_b, uk_rigid
 from gmuk.bodies import BodyKind
 from gmuk.control._kernels import apply_control
+from gmuk.errors import ConstraintError
 from gmuk.forces._kernels import apply_term
 from gmuk.gravity import _kernels as _field_kernels
 from gmuk.integrators import _dop853_tableau as _tab
@@ -341,6 +342,12 @@ class PythonParts:
         self._unmodeled = self.io[self.loads_at + nd : self.loads_at + 2 * nd]
         self._state: State | None = None
         self.error: BaseException | None = None
+        # resolved once: the callback runs at every evaluation
+        from gmuk.constraints.base import as_rows
+        from gmuk.state import State as _State
+        from gmuk.system import _pair
+
+        self._as_rows, self._make_state, self._pair = as_rows, _State, _pair
         self._c_function = _CALLBACK_TYPE(self._call)  # kept alive with the program
         self.address = int(ctypes.cast(self._c_function, ctypes.c_void_p).value or 0)
 
@@ -368,13 +375,8 @@ class PythonParts:
 
     def evaluate(self) -> None:
         """The parts' loads and rows at the state in ``io``, into ``io``."""
-        from gmuk.constraints.base import as_rows
-        from gmuk.errors import ConstraintError
-        from gmuk.state import State
-        from gmuk.system import _pair
-
         io, lay = self.io, self.layout
-        self._state = state = State(
+        self._state = state = self._make_state(
             float(io[0]),
             io[self._g].reshape(lay.n_rigid, 4, 4).copy(),
             io[self._V].reshape(lay.n_rigid, 6).copy(),
@@ -389,8 +391,8 @@ class PythonParts:
             self.system._add_loads(self.forces, state, self._modeled, self._unmodeled)
         nd = lay.n_dof
         for c, width, where, rows, at in self.constraints:
-            Ai, bi = _pair(c, state)
-            Ai, bi = as_rows(Ai, bi, width, f"constraint {c.name!r}")
+            Ai, bi = self._pair(c, state)
+            Ai, bi = self._as_rows(Ai, bi, width, f"constraint {c.name!r}")
             if bi.size != rows:
                 raise ConstraintError(
                     f"constraint {c.name!r} gave {bi.size} rows at t = {state.t:.9g} s and "
