@@ -848,7 +848,10 @@ def initial_step(t, Y, G0, f0, t_end, first_step, max_step, order, parts, fs, in
     f1 = np.empty(n)
     aux = np.empty(5 * ndof + parts[9][4] + 1 + parts[9][6])
     ints[I_RHS] += 1
-    if _evaluate(t + h0, Y + h0 * f0, G0, parts, f1, aux, ints, fs) != 0:
+    status = rhs(t + h0, Y + h0 * f0, G0, parts, f1, aux)
+    if status != 0:
+        ints[I_FIELD] = status
+        fs[F_BAD_T] = t + h0
         return -1.0
     acc = 0.0
     for i in range(n):
@@ -859,19 +862,6 @@ def initial_step(t, Y, G0, f0, t_end, first_step, max_step, order, parts, fs, in
     else:
         h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
     return min(100 * h0, h1, max_step, t_end - t)
-
-
-@njit(cache=True)
-def _evaluate(t, Y, G0, parts, dY, aux, ints, fs):  # type: ignore[no-untyped-def]
-    """:func:`rhs` at (t, Y); on a failure, record its time (fs[F_BAD_T]) and status
-    (ints[I_FIELD]) and return the loop's status for it (FIELD for a force kernel's), else 0.
-    The caller counts the evaluation in ints[I_RHS] where the Python loop counts it."""
-    bad = rhs(t, Y, G0, parts, dY, aux)
-    if bad == 0:
-        return 0
-    fs[F_BAD_T] = t
-    ints[I_FIELD] = bad
-    return bad if bad > -100 else FIELD
 
 
 @njit(cache=True)
@@ -980,13 +970,17 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
         # stages
         for j in range(n):
             K[0, j] = f0[j]
+        bad = 0
         for i in range(1, s):
             _stage_state(Y, h_try, A[i], K, i, Yt)
             ints[I_RHS] += 1
-            status = _evaluate(t + c[i] * h_try, Yt, G0, parts, K[i], tmp_aux, ints, fs)
-            if status != 0:
+            bad = rhs(t + c[i] * h_try, Yt, G0, parts, K[i], tmp_aux)
+            if bad != 0:
+                fs[F_BAD_T] = t + c[i] * h_try
                 break
-        if status != 0:
+        if bad != 0:
+            status = bad if bad > -100 else FIELD
+            ints[I_FIELD] = bad
             break
         for j in range(n):
             q = 0.0
@@ -994,8 +988,11 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
                 q += b[i] * K[i, j]
             Y1[j] = Y[j] + h_try * q
         ints[I_RHS] += 1
-        status = _evaluate(t + h_try, Y1, G0, parts, f1, aux1, ints, fs)
-        if status != 0:
+        bad = rhs(t + h_try, Y1, G0, parts, f1, aux1)
+        if bad != 0:
+            fs[F_BAD_T] = t + h_try
+            status = bad if bad > -100 else FIELD
+            ints[I_FIELD] = bad
             break
         if fsal:
             for j in range(n):
@@ -1041,10 +1038,13 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
             for i in range(ne_rows, _tab.N_STAGES_EXTENDED):
                 _stage_state(Y, h_try, Ax[i], Kx, i, Yt)
                 ints[I_RHS] += 1
-                status = _evaluate(t + Cx[i] * h_try, Yt, G0, parts, Kx[i], tmp_aux, ints, fs)
-                if status != 0:
+                bad = rhs(t + Cx[i] * h_try, Yt, G0, parts, Kx[i], tmp_aux)
+                if bad != 0:
+                    fs[F_BAD_T] = t + Cx[i] * h_try
                     break
-            if status != 0:
+            if bad != 0:
+                status = bad if bad > -100 else FIELD
+                ints[I_FIELD] = bad
                 break
             last = _tab.N_STAGES
             for j in range(n):
@@ -1075,8 +1075,11 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
                 for j in range(n):
                     u[j] += Y[j]
                 ints[I_RHS] += 1
-                status = _evaluate(t + s_star * h_try, u, G0, parts, ddy, tmp_aux, ints, fs)
-                if status != 0:
+                bad = rhs(t + s_star * h_try, u, G0, parts, ddy, tmp_aux)
+                if bad != 0:
+                    fs[F_BAD_T] = t + s_star * h_try
+                    status = bad if bad > -100 else FIELD
+                    ints[I_FIELD] = bad
                     break
                 acc2 = 0.0
                 for j in range(n):
@@ -1092,15 +1095,18 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
                 tt = outs[out_i]
                 w = ints[I_WRITTEN]
                 _interpolate(F, Y, (tt - t) / h_try, bY[w])
-                status = _evaluate(tt, bY[w], G0, parts, ddy, baux[w], ints, fs)  # not counted
-                if status != 0:
+                bad = rhs(tt, bY[w], G0, parts, ddy, baux[w])
+                if bad != 0:
+                    fs[F_BAD_T] = tt
                     break
                 bt[w] = tt
                 for k in range(nr):
                     bG[w, k] = G0[k]
                 ints[I_WRITTEN] = w + 1
                 out_i += 1
-            if status != 0:
+            if bad != 0:
+                status = bad if bad > -100 else FIELD
+                ints[I_FIELD] = bad
                 break
         # the new base G₁ = G₀ exp(ξ₁), re-orthonormalised: R ← R(3I − RᵀR)/2
         if nr:
