@@ -24,6 +24,13 @@ kernel at decoration time and, when the user cache folder is needed, sets
 cache location of every other numba user in the process are left alone, and the import
 order of numba and gmuk does not matter.
 
+Damaged cache files
+-------------------
+A cache file that cannot be read (truncated by a full disk or a killed process, or written
+by a numba whose format differs) is not an error: :func:`njit` gives each cached kernel a
+cache that treats such a file as a miss, removes its index (a :class:`GmukWarning` names it)
+and compiles the kernel again, which writes a fresh one.
+
 Calling without the dispatcher
 ------------------------------
 numba's dispatcher resolves the types of a kernel's arguments on every call, which costs
@@ -41,12 +48,16 @@ import inspect
 import os
 import sys
 import tempfile
+import warnings
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import numba
+from numba.core.caching import FunctionCache
+
+from gmuk.errors import GmukWarning
 
 __all__ = ["LazyEntries", "cache_plan", "compiled_entry", "entry", "njit", "user_cache_dir"]
 
@@ -145,6 +156,55 @@ def _cache_dir(directory: str) -> Iterator[None]:
         _config.CACHE_DIR = before
 
 
+class _CheckedCache(FunctionCache):
+    """numba's function cache, with an unreadable cache file taken as a miss: the file's
+    index is removed (so that the next save writes a fresh one) and the kernel compiles."""
+
+    def load_overload(self, sig: Any, target_context: Any) -> Any:
+        try:
+            return super().load_overload(sig, target_context)
+        except Exception as exc:  # a damaged or foreign file: pickle, EOF, OS errors …
+            self._discard(exc)
+            return None
+
+    def save_overload(self, sig: Any, data: Any) -> None:
+        try:
+            super().save_overload(sig, data)
+        except Exception as exc:  # the index it appends to is damaged: start a new one
+            self._discard(exc)
+            with _suppressed():
+                super().save_overload(sig, data)
+
+    def _discard(self, exc: Exception) -> None:
+        index = getattr(getattr(self, "_cache_file", None), "_index_path", None)
+        if index is None:
+            return
+        warnings.warn(
+            f"gmuk: a damaged numba cache file ({index}: {type(exc).__name__}) was removed; "
+            "the kernel is compiled again",
+            GmukWarning,
+            stacklevel=2,
+        )
+        with _suppressed():
+            os.unlink(index)
+
+
+@contextmanager
+def _suppressed() -> Iterator[None]:
+    """Ignore any error inside (a cache that cannot be written is no reason to fail)."""
+    try:
+        yield
+    except Exception:  # the kernel runs uncached
+        pass
+
+
+def _checked(dispatcher: Any) -> Any:
+    """``dispatcher`` with its numba cache replaced by :class:`_CheckedCache`."""
+    if type(getattr(dispatcher, "_cache", None)) is FunctionCache:
+        dispatcher._cache.__class__ = _CheckedCache
+    return dispatcher
+
+
 def njit(*args: Any, **options: Any) -> Any:
     """:func:`numba.njit`, with the cache of ``cache=True`` kernels placed as described in the
     module docstring.
@@ -161,7 +221,7 @@ def njit(*args: Any, **options: Any) -> Any:
         configured = str(_config.CACHE_DIR or "")
         cache, directory = _plan_for(str(Path(inspect.getfile(func)).parent), configured)
         with _cache_dir(directory):
-            return numba.njit(*args, **{**options, "cache": cache})(func)
+            return _checked(numba.njit(*args, **{**options, "cache": cache})(func))
 
     return decorate
 

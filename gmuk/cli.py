@@ -93,8 +93,8 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("--verbose", action="store_true", help="print each row as computed")
     sub.add_parser(
         "compile",
-        help="compile the step loop now (once per machine, 10-30 s; runs otherwise compile it "
-        "in the background on first use)",
+        help="compile the step loop now (once per machine, 30-60 s; the first run compiles it "
+        "otherwise, and says so)",
     )
     _add_view_parser(sub)
     # issue #16: campaigns (gmuk.campaign._cli parses their arguments)
@@ -444,7 +444,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             start = time.perf_counter()
             was = _compiled.loaded()
-            _compiled.compile_loop()
+            _compiled.compile_loop(announce=False)
             done = "was already compiled" if was else "compiled"
             print(f"the step loop {done} ({time.perf_counter() - start:.1f} s)")
             return 0

@@ -39,7 +39,7 @@ import sys
 import time
 import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -66,15 +66,13 @@ if TYPE_CHECKING:
 
 __all__ = ["METHODS", "compile_loop", "simulate"]
 
-#: Compile the step loop now (once per machine); see :func:`simulate`'s ``compiled``.
+#: Compile the step loop now (once per machine); :func:`simulate` does it on first use.
 compile_loop = _compiled.compile_loop
 
 
-class _Problem:
-    """The RKMK vector field on Y = [ξ (6 n_r), V (6 n_r), x, ẋ, z] about base poses G₀.
-
-    ``G0`` holds the current step's base poses; the stepper sets it before each step.
-    """
+class _Packing:
+    """The integrator's state vector Y = [ξ (6 n_r), V (6 n_r), x, ẋ, z] of a System about
+    base poses G₀: where each part sits, and the conversions to and from a State."""
 
     def __init__(self, system: System) -> None:
         self.system = system
@@ -96,9 +94,6 @@ class _Problem:
         if pts:
             cols = np.array(pts, dtype=np.intp)[:, None] + np.arange(3)
             self.point_idx = np.concatenate([self.s_x.start + cols, self.s_xd.start + cols])
-        self.G0: FloatArray = np.zeros((self.nr, 4, 4))
-        self.acc: Accelerations | None = None
-        self.n_rhs = 0
 
     def pack(self, state: State) -> FloatArray:
         Y = np.zeros(self.size)
@@ -121,77 +116,12 @@ class _Problem:
             self.layout,
         )
 
-    def deriv(self, Y: FloatArray, acc: Accelerations) -> FloatArray:
-        dY = np.empty(self.size)
-        xi = Y[self.s_xi].reshape(-1, 6)
-        V = Y[self.s_V].reshape(-1, 6)
-        if self.nr:
-            dY[self.s_xi] = _kernels.dexp_inv_apply(xi, V).ravel() if xi.any() else V.ravel()
-            dY[self.s_V] = acc.total[self.rigid_idx].ravel()
-        e = self.layout.euclid_offsets
-        dY[self.s_x] = Y[self.s_xd]
-        dY[self.s_xd] = acc.total[e]
-        dY[self.s_z] = acc.z_dot
-        return dY
-
-    def rhs(self, t: float, Y: FloatArray) -> FloatArray:
-        """dY/dt at (t, Y) about ``G0``: the method's ``f``. The System's accelerations of
-        the latest call are kept in ``acc`` (the step end records them)."""
-        self.n_rhs += 1
-        # the System's unchecked entry: simulate checked the layout once, and dY is checked
-        # for NaN and inf below (System.accelerations would check the results a second time)
-        self.acc = acc = self.system._accelerations(self.state(t, Y, self.G0))
-        dY = self.deriv(Y, acc)
-        if not np.isfinite(dY).all():
-            raise FloatingPointError(f"non-finite derivative at t = {t:.9g} s")
-        return dY
-
-    def scale(
-        self, Y0: FloatArray, Y1: FloatArray, G0: FloatArray, rtol: float, atol: float
-    ) -> FloatArray:
-        """Error weights, one per entry of Y (the larger of the values at both ends).
-
-        Every 3-vector is weighed by its norm, so that no weight depends on how the
-        inertial or body axes are chosen: ξ's rotation part against 1 rad, its translation
-        part (body-frame components) against the distance ‖r‖ of the base pose, the twist's
-        ω and v and a point mass's position and velocity by their norms. Scalars (slack
-        coordinates, controller states) by their absolute values.
-        """
-        sc = atol + rtol * np.maximum(np.abs(Y0), np.abs(Y1))
-        if self.nr:
-            r = np.linalg.norm(G0[:, :3, 3], axis=1)
-            xi_sc = np.empty((self.nr, 2, 3))
-            xi_sc[:, 0] = atol + rtol
-            xi_sc[:, 1] = (atol + rtol * r)[:, None]
-            sc[self.s_xi] = xi_sc.ravel()
-            V = np.maximum(
-                np.linalg.norm(Y0[self.s_V].reshape(-1, 2, 3), axis=2),
-                np.linalg.norm(Y1[self.s_V].reshape(-1, 2, 3), axis=2),
-            )
-            sc[self.s_V] = np.repeat(atol + rtol * V, 3)
-        idx = self.point_idx
-        if idx is not None:
-            n = np.maximum(np.linalg.norm(Y0[idx], axis=1), np.linalg.norm(Y1[idx], axis=1))
-            sc[idx] = (atol + rtol * n)[:, None]
-        return sc
-
-    def advance_base(self, Y: FloatArray, G0: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """G₁ = G₀ exp(ξ₁), re-orthonormalised; returns (G₁, Y with ξ reset to 0)."""
-        if not self.nr:
-            return G0, Y
-        G1 = _kernels.compose_exp(G0, Y[self.s_xi].reshape(-1, 6))
-        R = G1[:, :3, :3]
-        G1[:, :3, :3] = 0.5 * R @ (3.0 * np.eye(3) - np.swapaxes(R, -1, -2) @ R)
-        Y = Y.copy()
-        Y[self.s_xi] = 0.0
-        return G1, Y
-
 
 class _Recorder:
     """Collects output states and their diagnostics: rows of (State, Accelerations) from the
     Python loop, and blocks of arrays from the compiled one, in the order they come."""
 
-    def __init__(self, problem: _Problem, prefix: Trajectory | None = None) -> None:
+    def __init__(self, problem: _Packing, prefix: Trajectory | None = None) -> None:
         self.p = problem
         self.rows: list[tuple[State, Accelerations]] = []
         # Earlier output: column blocks (dicts of arrays), each followed by the rows after it.
@@ -344,27 +274,21 @@ def simulate(
         ``status="failed"`` and the reason in ``message``. A KeyboardInterrupt always returns
         the trajectory so far with ``status="interrupted"`` (and a warning).
     compiled : bool, optional
-        Run the step loop compiled (:mod:`gmuk.integrators._compiled`): None (default) when the
-        System qualifies — rigid bodies, point masses and slack coordinates, solved by the
-        ``"fused"`` or ``"dense"`` strategy (or unconstrained) — and the method is DOP853 or a plain
-        tableau; True requires it (a :class:`~gmuk.errors.DefinitionError` says why a System does
-        not qualify); False always runs the Python loop. Built-in force models, the LVLH tracking
-        and relative constraints and the Morse–Lyapunov law run compiled; any other force model,
-        constraint or controller is called in Python from inside the compiled loop, and costs only
-        its own Python. Both loops give the same results to rounding (docs/architecture.rst);
-        ``stats["compiled"]`` says which ran. A failure inside the compiled loop (a part that
-        raises, a field evaluated inside the body, a NaN, a step-size underflow, a solve it cannot
-        certify) is retried by the Python loop from the last accepted step, which raises the error
-        it always raises, with the trajectory so far. The loop is compiled once per machine and then
-        loaded from numba's cache: under None, a run that finds it not compiled yet takes the Python
-        loop and starts the compilation in a background process for the runs after it
-        (:func:`compile_loop` compiles it now; ``GMUK_BACKGROUND_COMPILE=0`` turns the background
-        process off), while True compiles it in this process first.
+        Deprecated and ignored: every run takes gmuk's one loop, compiled
+        (:mod:`gmuk.integrators._compiled`). Built-in force models, the LVLH tracking and
+        relative constraints and the Morse–Lyapunov law run compiled; any other force model,
+        constraint, controller or solve strategy is called back in Python from inside the loop
+        and costs only its own Python. ``compiled=False`` raises a DefinitionError (the
+        Python loop is a test oracle now, :func:`gmuk.testing.reference_simulate`). The loop is
+        compiled once per machine, on first use, in this process (announced on stderr in one
+        line; ``gmuk compile`` does it ahead) and then loaded from numba's cache: the results do
+        not depend on the cache's state.
 
     Returns
     -------
     Trajectory
-        ``stats["method"]`` holds the method's name.
+        ``stats`` holds the method's name, the numbers of evaluations, steps and rejected
+        steps, and the versions of gmuk, numba and numpy that computed it.
 
     Raises
     ------
@@ -379,6 +303,134 @@ def simulate(
     requested (``status="interrupted"``, no warning), writes checkpoints of its progress, and
     resumes from them (see :mod:`gmuk.runs`); ``gmuk run`` uses this.
     """
+    run = check_run(
+        system, state0, t_span, t_eval=t_eval, method=method, rtol=rtol, atol=atol, step=step,
+        first_step=first_step, max_step=max_step, max_steps=max_steps, on_failure=on_failure,
+    )  # fmt: skip
+    if progress is not None and not isinstance(progress, (bool, np.bool_)):
+        raise DefinitionError(f"progress must be True, False or None; got {progress!r}")
+    if compiled is not None:
+        if not isinstance(compiled, (bool, np.bool_)):
+            raise DefinitionError(f"compiled must be True, False or None; got {compiled!r}")
+        if not compiled:
+            raise DefinitionError(
+                "compiled=False: gmuk has one loop, the compiled one; the Python loop is a test "
+                "oracle (gmuk.testing.reference_simulate)"
+            )
+        warnings.warn(
+            "simulate(compiled=...) is deprecated: every run is compiled",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+    _compiled.method_table(run.method)  # a method the loop cannot run: say so first
+    control = runs.current()
+    checkpoint = control.next_path() if control is not None else None
+    prefix: Trajectory | None = None
+    record: dict[str, Any] | None = None
+    fingerprint = ""
+    if checkpoint is not None:
+        settings = {
+            "t_span": (run.t0, run.t1),
+            "method": label(run.method),
+            "rtol": run.rtol,
+            "atol": run.atol,
+            "step": run.step,
+            "first_step": run.first_step,
+            "max_step": run.max_step,
+        }
+        fingerprint = runs.fingerprint(run.state0, settings, run.outs)
+        if control is not None and control.resume and checkpoint.exists():
+            prefix, record = runs.load(checkpoint, fingerprint)
+            if record["complete"]:
+                return prefix
+    packing = _Packing(system)
+    rec = _Recorder(packing, prefix)
+    loop = _Loop(packing, run)
+    loop.control, loop.checkpoint = control, checkpoint
+    loop.fingerprint, loop.recorder = fingerprint, rec
+    bar = _Progress(progress, run.t0, run.t1)
+    status, message = "success", ""
+    try:
+        loop.run(rec, bar, resume=record)
+    except _StopRequested:
+        status, message = "interrupted", f"stopped on request at t = {loop.t:.9g} s"
+    except KeyboardInterrupt:
+        status, message = "interrupted", f"interrupted by the user at t = {loop.t:.9g} s"
+        warnings.warn(message + "; returning the trajectory so far", GmukWarning, stacklevel=2)
+    except Exception as exc:
+        status = "failed"
+        message = f"failed at t = {loop.t:.9g} s: {_describe(exc)}"
+        if run.on_failure == "raise":
+            traj = rec.build(status, message, loop.stats())
+            bar.close()
+            loop.save_checkpoint(traj)
+            raise SimulationError(message, traj) from exc
+    finally:
+        bar.close()
+    traj = rec.build(status, message, loop.stats())
+    loop.save_checkpoint(traj)
+    return traj
+
+
+def _describe(exc: BaseException) -> str:
+    """A failure's reason: the loop's own failures by their message, a part's error with its
+    type."""
+    if isinstance(exc, _LoopFailure):
+        return str(exc)
+    return f"{type(exc).__name__}: {exc}"
+
+
+def _times(t_eval: Any) -> FloatArray:
+    """``t_eval`` as a 1-D float array of finite real times, or a DefinitionError."""
+    bad = DefinitionError(f"t_eval must be an array of finite real times (s); got {t_eval!r:.60}")
+    try:
+        raw = np.asarray(t_eval)
+    except (TypeError, ValueError, OverflowError):
+        raise bad from None
+    if raw.dtype.kind not in "iuf":
+        raise bad
+    try:
+        outs = raw.astype(float).reshape(-1)
+    except OverflowError:
+        raise bad from None
+    if not np.isfinite(outs).all():
+        raise bad
+    return outs
+
+
+class _Run(NamedTuple):
+    """The checked arguments of a run."""
+
+    method: RungeKuttaMethod
+    state0: State
+    t0: float
+    t1: float
+    outs: FloatArray | None
+    rtol: float
+    atol: float
+    step: float | None
+    first_step: float | None
+    max_step: float
+    max_steps: int
+    on_failure: str
+
+
+def check_run(
+    system: System,
+    state0: State,
+    t_span: Any,
+    *,
+    t_eval: Any,
+    method: Any,
+    rtol: Any,
+    atol: Any,
+    step: Any,
+    first_step: Any,
+    max_step: Any,
+    max_steps: Any,
+    on_failure: Any,
+) -> _Run:
+    """:func:`simulate`'s arguments checked (a DefinitionError names the first bad one)."""
     m = get_method(method)
     if not isinstance(on_failure, str) or on_failure not in ("raise", "return"):
         raise DefinitionError(f"on_failure must be 'raise' or 'return'; got {on_failure!r}")
@@ -428,135 +480,51 @@ def simulate(
         raise DefinitionError(f"max_steps must be an integer >= 1; got {max_steps!r}")
     if max_steps < 1:
         raise DefinitionError(f"max_steps must be an integer >= 1; got {max_steps!r}")
-    if progress is not None and not isinstance(progress, (bool, np.bool_)):
-        raise DefinitionError(f"progress must be True, False or None; got {progress!r}")
-    if compiled is not None and not isinstance(compiled, (bool, np.bool_)):
-        raise DefinitionError(f"compiled must be True, False or None; got {compiled!r}")
-    plan: _compiled.Program | str = "not asked for"
-    if compiled is None or compiled:
-        plan = _compiled.program(system, m, state0.replace(t=t0))
-        if compiled and isinstance(plan, str):
-            raise DefinitionError(f"this System cannot run compiled: {plan}")
-        if compiled:
-            _compiled.compile_loop()
-        elif not isinstance(plan, str) and not _compiled.loaded(plan):
-            if _compiled.compile_on_first_use:
-                _compiled.compile_loop()
-            else:
-                # first use on this machine: compiling takes 10-30 s, more than most runs:
-                # this run takes the Python loop while another process compiles the loop
-                _compiled.compile_loop(background=True)
-                plan = "the compiled loop is not compiled yet on this machine"
-
-    state0 = state0.replace(t=t0)
-    control = runs.current()
-    checkpoint = control.next_path() if control is not None else None
-    prefix: Trajectory | None = None
-    record: dict[str, Any] | None = None
-    fingerprint = ""
-    if checkpoint is not None:
-        settings = {
-            "t_span": (t0, t1),
-            "method": label(m),
-            "rtol": rtol,
-            "atol": atol,
-            "step": step,
-            "first_step": first_step,
-            "max_step": max_step,
-        }
-        fingerprint = runs.fingerprint(state0, settings, outs)
-        if control is not None and control.resume and checkpoint.exists():
-            prefix, record = runs.load(checkpoint, fingerprint)
-            if record["complete"]:
-                return prefix
-    prob = _Problem(system)
-    rec = _Recorder(prob, prefix)
-    stepper = (
-        _Stepper(prob, m, rtol, atol, step, first_step, max_step)
-        if isinstance(plan, str)
-        else _CompiledStepper(prob, m, rtol, atol, step, first_step, max_step, plan)
-    )
-    stepper.control, stepper.checkpoint = control, checkpoint
-    stepper.fingerprint, stepper.recorder = fingerprint, rec
-    bar = _Progress(progress, t0, t1)
-    status, message = "success", ""
-    try:
-        stepper.run(state0, t1, outs, rec, max_steps, bar, resume=record)
-    except _StopRequested:
-        status, message = "interrupted", f"stopped on request at t = {stepper.t:.9g} s"
-    except KeyboardInterrupt:
-        status, message = "interrupted", f"interrupted by the user at t = {stepper.t:.9g} s"
-        warnings.warn(message + "; returning the trajectory so far", GmukWarning, stacklevel=2)
-    except Exception as exc:
-        status = "failed"
-        message = f"failed at t = {stepper.t:.9g} s: {type(exc).__name__}: {exc}"
-        if on_failure == "raise":
-            traj = rec.build(status, message, stepper.stats())
-            bar.close()
-            stepper.save_checkpoint(traj)
-            raise SimulationError(message, traj) from exc
-    finally:
-        bar.close()
-    traj = rec.build(status, message, stepper.stats())
-    stepper.save_checkpoint(traj)
-    return traj
-
-
-def _times(t_eval: Any) -> FloatArray:
-    """``t_eval`` as a 1-D float array of finite real times, or a DefinitionError."""
-    bad = DefinitionError(f"t_eval must be an array of finite real times (s); got {t_eval!r:.60}")
-    try:
-        raw = np.asarray(t_eval)
-    except (TypeError, ValueError, OverflowError):
-        raise bad from None
-    if raw.dtype.kind not in "iuf":
-        raise bad
-    try:
-        outs = raw.astype(float).reshape(-1)
-    except OverflowError:
-        raise bad from None
-    if not np.isfinite(outs).all():
-        raise bad
-    return outs
+    return _Run(
+        m, state0.replace(t=t0), t0, t1, outs, rtol, atol, step, first_step, max_step,
+        int(max_steps), on_failure,
+    )  # fmt: skip
 
 
 class _StopRequested(Exception):
     """The run's RunControl asked the simulation to stop (gmuk.runs)."""
 
 
-def _step_factor(err: float, order: int) -> float:
-    """The step-size factor for a scaled error estimate ``err`` (1: at tolerance): the
-    classical ``0.9 err^(−1/order)``, with err floored so that a zero estimate grows the step
-    by the callers' upper clip."""
-    return 0.9 * (max(err, 1e-10) ** (-1.0 / order))
+class _LoopFailure(GmukError, RuntimeError):
+    """The loop's own failures: step-size underflow, too many steps, a non-finite
+    derivative (the message says which)."""
 
 
-class _StepFailure(RuntimeError):
-    """Step-size underflow or too many steps."""
+def _versions() -> dict[str, str]:
+    """The versions of gmuk and the libraries that computed a run."""
+    import numba
+
+    from gmuk import __version__
+
+    return {"gmuk": __version__, "numba": numba.__version__, "numpy": np.__version__}
 
 
-class _Stepper:
-    """The RKMK step loop: step-size control, output times, base-pose updates. Everything
-    that depends on the Runge–Kutta method is asked of the method object."""
+#: The loop's output buffers: times, states Y, base poses and the right-hand side's other
+#: outputs (gmuk.integrators._compiled.aux_layout), one row per output.
+_Buffers = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
 
-    def __init__(
-        self,
-        prob: _Problem,
-        method: RungeKuttaMethod,
-        rtol: float,
-        atol: float,
-        step: float | None,
-        first_step: float | None,
-        max_step: float,
-    ) -> None:
-        self.p = prob
-        self.method = method
-        self.rtol, self.atol = rtol, atol
-        self.fixed = step
-        self.first_step = first_step
-        self.max_step = max_step
-        self.t = 0.0
-        self.n_steps = self.n_rejected = 0
+
+class _Loop:
+    """Drives the compiled loop (:func:`gmuk.integrators._compiled.advance`) in chunks of
+    steps; between chunks Python drains the outputs, updates the progress bar, sees stop
+    requests and writes checkpoints. A failure is raised with the trajectory so far kept in
+    the recorder; nothing is ever retried by another loop."""
+
+    #: Steps per chunk: a chunk is the longest a stop request waits.
+    chunk = 256
+
+    def __init__(self, packing: _Packing, run: _Run) -> None:
+        self.p = packing
+        self.run_args = run
+        self.method = run.method
+        self.rtol, self.atol = run.rtol, run.atol
+        self.t = run.t0
+        self.n_steps = self.n_rejected = self.n_rhs = 0
         # Checkpointing (gmuk.runs): the last accepted step's integrator state.
         self.control: runs.RunControl | None = None
         self.checkpoint: Path | None = None
@@ -564,6 +532,18 @@ class _Stepper:
         self.recorder: _Recorder | None = None
         self.last_save = time.monotonic()
         self.at: tuple[FloatArray, FloatArray, float, int] | None = None  # Y, G0, h, out_i
+
+    def stats(self) -> dict[str, Any]:
+        return {
+            "n_rhs": self.n_rhs,
+            "n_steps": self.n_steps,
+            "n_rejected": self.n_rejected,
+            "method": label(self.method),
+            "rtol": self.rtol,
+            "atol": self.atol,
+            "compiled": True,
+            "versions": _versions(),
+        }
 
     def save_checkpoint(self, traj: Trajectory | None = None) -> None:
         """Write the checkpoint (the trajectory so far and the last accepted step)."""
@@ -583,12 +563,12 @@ class _Stepper:
             "G0": G0.ravel().tolist(),
             "n_steps": self.n_steps,
             "n_rejected": self.n_rejected,
-            "n_rhs": self.p.n_rhs,
+            "n_rhs": self.n_rhs,
         }
         runs.save(self.checkpoint, traj, record)
         self.last_save = time.monotonic()
 
-    def _after_step(self) -> None:
+    def _after_chunk(self) -> None:
         control = self.control
         if control is None:
             return
@@ -597,194 +577,20 @@ class _Stepper:
         if self.checkpoint is not None and time.monotonic() - self.last_save >= control.every_s:
             self.save_checkpoint()
 
-    def stats(self) -> dict[str, Any]:
-        return {
-            "n_rhs": self.p.n_rhs,
-            "n_steps": self.n_steps,
-            "n_rejected": self.n_rejected,
-            "method": label(self.method),
-            "rtol": self.rtol,
-            "atol": self.atol,
-            "compiled": isinstance(self, _CompiledStepper),
-        }
-
-    def _initial_step(self, t: float, Y: FloatArray, f0: FloatArray, t_end: float) -> float:
-        if self.first_step is not None:
-            return min(self.first_step, t_end - t)
-        sc = self.p.scale(Y, Y, self.p.G0, self.rtol, self.atol)
-        d0 = np.sqrt(np.mean((Y / sc) ** 2))
-        d1 = np.sqrt(np.mean((f0 / sc) ** 2))
-        h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
-        h0 = min(h0, t_end - t)
-        f1 = self.p.rhs(t + h0, Y + h0 * f0)
-        d2 = np.sqrt(np.mean(((f1 - f0) / sc) ** 2)) / h0
-        if d1 <= 1e-15 and d2 <= 1e-15:
-            h1 = max(1e-6, h0 * 1e-3)
-        else:
-            h1 = (0.01 / max(d1, d2)) ** (1.0 / (self.method.order + 1))
-        return float(min(100 * h0, h1, self.max_step, t_end - t))
-
-    def run(
-        self,
-        state0: State,
-        t_end: float,
-        outs: FloatArray | None,
-        rec: _Recorder,
-        max_steps: int,
-        bar: _Progress,
-        resume: dict[str, Any] | None = None,
-    ) -> None:
-        p, m = self.p, self.method
-        f = p.rhs
-        b, s, order = m.b, m.n_stages, m.order
-        fsal, adaptive = m.fsal, m.adaptive
-        dense = m.dense_output and outs is not None
-        step_to_outputs = m.steps_onto_outputs and outs is not None
-        rtol, atol = self.rtol, self.atol
-        G0: FloatArray
-        Y: FloatArray
-        if resume is not None:  # from the last accepted step of a checkpoint (gmuk.runs)
-            t = self.t = float(resume["t"])
-            G0 = np.array(resume["G0"], dtype=float).reshape(state0.g.shape)
-            p.G0 = G0
-            Y = np.array(resume["Y"], dtype=float)
-            if Y.shape != (p.size,):
-                raise runs.CheckpointError(
-                    f"checkpoint state has {Y.size} entries; expected {p.size}"
-                )
-            p.n_rhs = int(resume.get("n_rhs", 0))
-            self.n_steps = int(resume.get("n_steps", 0))
-            self.n_rejected = int(resume.get("n_rejected", 0))
-            f0 = f(t, Y)
-            out_i = int(resume["out_i"])
-            h = float(resume["h"])
-        else:
-            t = self.t = state0.t
-            G0 = p.G0 = state0.g.copy()
-            Y = p.pack(state0)
-            if self.control is not None and self.control.stop_requested:
-                rec.add(state0)  # asked to stop before starting: the initial state only
-                raise _StopRequested
-            f0 = f(t, Y)
-            acc0 = p.acc
-            assert acc0 is not None
-            out_i = 0
-            if outs is None or outs[0] == t:
-                rec.add(state0, acc0)
-                out_i = 0 if outs is None else 1
-            h = self._initial_step(t, Y, f0, t_end) if adaptive else float(self.fixed or 0)
-        self.at = (Y, G0, h, out_i)
-        while t < t_end:
-            if self.n_steps >= max_steps:
-                raise _StepFailure(f"reached max_steps = {max_steps}")
-            h = min(h, self.max_step)
-            t_target = t_end
-            if step_to_outputs and outs is not None and out_i < outs.size:
-                t_target = min(t_end, outs[out_i])
-            # Land exactly on the target when within a hair of it (no sliver steps); t + h_try
-            # may round to a neighbour of t_target, so the step ends at t_target itself.
-            landing = t_target - t <= h * (1.0 + 1e-6)
-            h_try = t_target - t if landing else h
-            if h_try <= 10 * np.finfo(float).eps * max(1.0, abs(t)):
-                raise _StepFailure(f"step size underflow (h = {h_try:.3g} s)")
-            K = m.stages(f, t, Y, h_try, f0)
-            Y1 = Y + h_try * (b @ K[:s])
-            f1 = f(t + h_try, Y1)  # reused as the next step's first stage
-            acc1 = p.acc
-            if fsal:
-                K[-1] = f1
-            if adaptive:
-                sc = p.scale(Y, Y1, G0, rtol, atol)
-                err = m.error_norm(K, h_try, sc)
-                factor = _step_factor(err, order)
-                if err > 1.0:
-                    self.n_rejected += 1
-                    h = h_try * max(0.2, min(0.9, factor))
-                    continue
-                h_next = h_try * min(10.0, max(0.2, factor))
-            else:
-                h_next = h
-            t_new = t_target if landing else t + h_try
-            if dense and outs is not None:
-                hit = outs[out_i:][outs[out_i:] < t_new]
-                if hit.size:
-                    interp = m.interpolant(f, t, Y, h_try, K, Y1)
-                    if adaptive:
-                        # Output times inside the step: the continuous extension must meet
-                        # the tolerance as well, or the step is retried shorter.
-                        err_d = m.interpolant_error(f, interp, sc)
-                        factor_d = _step_factor(err_d, order)
-                        if err_d > 1.0:
-                            self.n_rejected += 1
-                            h = h_try * max(0.2, min(0.9, factor_d))
-                            continue
-                        h_next = min(h_next, h_try * min(10.0, max(0.2, factor_d)))
-                    for tt in hit:
-                        st = p.state(float(tt), interp(float(tt)), G0)
-                        rec.add(st)
-                        out_i += 1
-            G1, Y1r = p.advance_base(Y1, G0)
-            state1 = p.state(t_new, Y1r, G1)
-            assert acc1 is not None
-            f0 = p.deriv(Y1r, acc1)  # same accelerations; ξ̇ = V at the new base (ξ = 0)
-            if outs is None or (out_i < outs.size and outs[out_i] == t_new):
-                rec.add(state1, acc1)
-                if outs is not None:
-                    out_i += 1
-            t, Y, G0, h = t_new, Y1r, G1, h_next
-            p.G0 = G0
-            self.t = t
-            self.n_steps += 1
-            self.at = (Y, G0, h, out_i)
-            bar.update(t)
-            self._after_step()
-
-
-#: The compiled loop's output buffers: times, states Y, base poses and the right-hand side's
-#: other outputs (gmuk.integrators._compiled.rhs), one row per output.
-_Buffers = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
-
-
-class _CompiledStepper(_Stepper):
-    """The step loop of :class:`_Stepper` run compiled (:mod:`gmuk.integrators._compiled`)
-    in chunks of steps; between chunks Python drains the outputs, updates the progress bar,
-    sees stop requests and writes checkpoints. A failure inside the compiled loop hands the
-    run to the Python loop at the last accepted step, which meets the same failure and
-    reports it as it always does."""
-
-    #: Steps per chunk: a chunk is the longest a stop request waits.
-    chunk = 256
-
-    def __init__(
-        self,
-        prob: _Problem,
-        method: RungeKuttaMethod,
-        rtol: float,
-        atol: float,
-        step: float | None,
-        first_step: float | None,
-        max_step: float,
-        program: _compiled.Program,
-    ) -> None:
-        super().__init__(prob, method, rtol, atol, step, first_step, max_step)
-        self.program = program
-
-    def _block(self, n_out: int, bufs: _Buffers, acc0: Accelerations) -> dict[str, Any]:
+    def _block(self, n_out: int, bufs: _Buffers, prog: _compiled.Program) -> dict[str, Any]:
         """The first ``n_out`` buffered outputs as Trajectory columns."""
         bt, bY, bG, baux = (b[:n_out] for b in bufs)
         p = self.p
         lay = p.layout
-        nr, nd, s = lay.n_rigid, lay.n_dof, self.program.s
+        nr = lay.n_rigid
         if nr:
             xi = bY[:, p.s_xi].reshape(-1, 6)
             g = _kernels.compose_exp(np.ascontiguousarray(bG).reshape(-1, 4, 4), xi)
         else:
             g = np.zeros((0, 4, 4))
-        if s:  # the fused solve certified every row: its rank is s
-            residual, rank = baux[:, 4 * nd + s].copy(), np.full(n_out, s, dtype=np.int64)
-        else:  # the unconstrained solve's constants
-            residual = np.full(n_out, float(acc0.residual))
-            rank = np.full(n_out, -1 if acc0.rank is None else acc0.rank, dtype=np.int64)
+        where = _compiled.aux_layout(lay.n_dof, prog.s, lay.n_control)
+        columns = {name: baux[:, where[name]].copy() for name in where if name != "z_dot"}
+        columns["rank"] = columns["rank"].astype(np.int64)
         return {
             "t": bt.copy(),
             "g_NB": g.reshape(n_out, nr, 4, 4),
@@ -792,31 +598,16 @@ class _CompiledStepper(_Stepper):
             "x": bY[:, p.s_x].copy(),
             "xdot": bY[:, p.s_xd].copy(),
             "z": bY[:, p.s_z].copy(),
-            "acceleration": baux[:, :nd].copy(),
-            "constraint_acceleration": baux[:, 2 * nd : 3 * nd].copy(),
-            "constraint_force": baux[:, 3 * nd : 4 * nd].copy(),
-            "control_force": baux[:, 4 * nd + s + 1 : 5 * nd + s + 1].copy(),
-            "unmodeled_force": baux[:, nd : 2 * nd].copy(),
-            "multipliers": baux[:, 4 * nd : 4 * nd + s].copy(),
-            "residual": residual,
-            "rank": rank,
+            **columns,
         }
 
-    def run(
-        self,
-        state0: State,
-        t_end: float,
-        outs: FloatArray | None,
-        rec: _Recorder,
-        max_steps: int,
-        bar: _Progress,
-        resume: dict[str, Any] | None = None,
-    ) -> None:
-        p, m, prog = self.p, self.method, self.program
+    def run(self, rec: _Recorder, bar: _Progress, resume: dict[str, Any] | None = None) -> None:
+        args, p = self.run_args, self.p
         n = p.size
-        ints = np.zeros(9, dtype=np.int64)
-        h = 0.0
-        if resume is not None:
+        ints = np.zeros(_compiled.N_INTS, dtype=np.int64)
+        fs = np.zeros(_compiled.N_FLOATS)
+        state0 = args.state0
+        if resume is not None:  # from the last accepted step of a checkpoint (gmuk.runs)
             t = float(resume["t"])
             G0 = np.array(resume["G0"], dtype=float).reshape(state0.g.shape)
             Y = np.array(resume["Y"], dtype=float)
@@ -826,50 +617,36 @@ class _CompiledStepper(_Stepper):
             ints[_compiled.I_STEPS] = int(resume.get("n_steps", 0))
             ints[_compiled.I_REJECTED] = int(resume.get("n_rejected", 0))
             ints[_compiled.I_OUT] = int(resume["out_i"])
-            h = float(resume["h"])
+            fs[_compiled.F_H] = float(resume["h"])
         else:
             t = state0.t
             G0 = state0.g.copy()
             Y = p.pack(state0)
+            ints[_compiled.I_FRESH] = 1
             if self.control is not None and self.control.stop_requested:
-                rec.add(state0)
+                rec.add(state0)  # asked to stop before starting: the initial state only
                 raise _StopRequested
+            if not self.method.adaptive:
+                fs[_compiled.F_H] = float(args.step or 0.0)
         self.t = t
-        p.G0 = G0
-        # the accelerations at the start, in Python: the constant residual and rank of an
-        # unconstrained solve, and the first output row exactly as the Python loop makes it
-        acc0 = self.p.system._accelerations(p.state(t, Y, G0))
-        n_aux = prog.n_aux
-        f0, aux = np.empty(n), np.empty(n_aux)
-        ints[_compiled.I_RHS] += 1
-        fs = np.array([t, 0.0, t_end, self.rtol, self.atol, self.max_step, 0.0])
-        status = _compiled.rhs(t, Y, G0, prog.parts, f0, aux)
-        if resume is None and status == 0:
-            if outs is None or outs[0] == t:
-                rec.add(state0, acc0)
-                ints[_compiled.I_OUT] = 0 if outs is None else 1
-            if not m.adaptive:
-                h = float(self.fixed or 0)
-            else:
-                h = _compiled.initial_step(
-                    t, Y, G0, f0, t_end, self.first_step or 0.0, self.max_step, m.order,
-                    prog.parts, fs, ints,
-                )  # fmt: skip
-                status = 0 if h > 0 else -1
-        p.n_rhs = int(ints[_compiled.I_RHS])
-        if status != 0:
-            self._raise_interrupt()
-            self._hand_over(state0, t_end, Y, G0, h, ints, outs, rec, max_steps, bar, resume)
-            return
-        out_arr = np.zeros(0) if outs is None else outs
-        cap = self.chunk + 1
-        bufs = self._buffers(cap, n, p.layout.n_rigid, n_aux)
-        ints[_compiled.I_MAX_STEPS] = max_steps
+        self.at = (Y.copy(), G0.copy(), float(fs[_compiled.F_H]), int(ints[_compiled.I_OUT]))
+        # the program reads the row counts of Python constraints at the start: a part that
+        # raises there fails the run at its start time
+        prog = _compiled.program(p.system, self.method, p.state(t, Y, G0))
+        _compiled.compile_loop()
+        fs[[_compiled.F_T, _compiled.F_END, _compiled.F_RTOL, _compiled.F_ATOL]] = (
+            t, args.t1, self.rtol, self.atol,
+        )  # fmt: skip
+        fs[_compiled.F_MAX_STEP] = args.max_step
+        fs[_compiled.F_FIRST_STEP] = args.first_step or 0.0
+        ints[_compiled.I_MAX_STEPS] = args.max_steps
         ints[_compiled.I_CHUNK] = self.chunk
-        fs[_compiled.F_H] = h
-        self.at = (Y.copy(), G0.copy(), h, int(ints[_compiled.I_OUT]))
+        outs = args.outs
+        out_arr = np.zeros(0) if outs is None else outs
+        f0, aux = np.empty(n), np.empty(prog.n_aux)
+        cap = self.chunk + 1
+        bufs = self._buffers(cap, n, p.layout.n_rigid, prog.n_aux)
         while True:
-            fs[_compiled.F_T] = t
             ints[_compiled.I_WRITTEN] = 0
             status = _compiled.advance(
                 prog.parts, prog.method, fs, ints, Y, G0, f0, aux,
@@ -877,72 +654,55 @@ class _CompiledStepper(_Stepper):
             )  # fmt: skip
             n_out = int(ints[_compiled.I_WRITTEN])
             if n_out:
-                rec.add_block(self._block(n_out, bufs, acc0))
-            t, h = float(fs[_compiled.F_T]), float(fs[_compiled.F_H])
-            self.t = t
-            p.G0 = G0
-            p.n_rhs = int(ints[_compiled.I_RHS])
+                rec.add_block(self._block(n_out, bufs, prog))
+            self.t = float(fs[_compiled.F_T])
+            self.n_rhs = int(ints[_compiled.I_RHS])
             self.n_steps = int(ints[_compiled.I_STEPS])
             self.n_rejected = int(ints[_compiled.I_REJECTED])
-            self.at = (Y.copy(), G0.copy(), h, int(ints[_compiled.I_OUT]))
-            bar.update(t)
+            if ints[_compiled.I_STARTED]:
+                h = float(fs[_compiled.F_H])
+                self.at = (Y.copy(), G0.copy(), h, int(ints[_compiled.I_OUT]))
+            bar.update(self.t)
             if status == _compiled.DONE:
                 return
             if status < 0:
-                self._raise_interrupt()
-                self._hand_over(state0, t_end, Y, G0, h, ints, outs, rec, max_steps, bar, resume)
-                return
+                raise self._failure(status, prog, fs, ints)
             if status == _compiled.FULL and n_out == 0:  # one step has more outputs than room
                 cap = 2 * int(ints[_compiled.I_NEED]) + cap
-                bufs = self._buffers(cap, n, p.layout.n_rigid, n_aux)
-            self._after_step()
+                bufs = self._buffers(cap, n, p.layout.n_rigid, prog.n_aux)
+            self._after_chunk()
 
-    def _raise_interrupt(self) -> None:
-        """Re-raise a KeyboardInterrupt (or another non-Exception) that a part evaluated in
-        Python caught from a signal; an Exception is left to the Python loop, which meets
-        it again at the same stage and reports it as it always does."""
-        python = self.program.python
-        if python is not None and python.error is not None:
-            error, python.error = python.error, None
-            if not isinstance(error, Exception):
-                raise error
+    def _failure(
+        self, status: int, prog: _compiled.Program, fs: FloatArray, ints: np.ndarray
+    ) -> BaseException:
+        """The exception that reports a failed chunk."""
+        t_bad = float(fs[_compiled.F_BAD_T])
+        if status == _compiled.CALLBACK:
+            error, prog.python.error = prog.python.error, None
+            if error is not None:
+                return error
+            return _LoopFailure(f"a part evaluated in Python failed at t = {t_bad:.9g} s")
+        if status == _compiled.UNDERFLOW:
+            return _LoopFailure(f"step size underflow (h = {float(fs[_compiled.F_H]):.3g} s)")
+        if status == _compiled.MAX_STEPS:
+            return _LoopFailure(f"reached max_steps = {self.run_args.max_steps}")
+        if status == _compiled.FIELD:
+            return self._field_failure(prog, t_bad, int(ints[_compiled.I_FIELD]))
+        return _LoopFailure(f"non-finite derivative at t = {t_bad:.9g} s")
+
+    def _field_failure(self, prog: _compiled.Program, t_bad: float, code: int) -> BaseException:
+        """A compiled force kernel's failure, described by the model that failed: the
+        System's Python accelerations at the failing stage (which the loop left in the
+        program's ``io``) raise the model's own error."""
+        try:
+            self.p.system.accelerations(prog.python.state())
+        except Exception as exc:  # the model's own description
+            return exc
+        return _LoopFailure(
+            f"a compiled force model failed (kernel status {code}) at t = {t_bad:.9g} s: "
+            "the field has no finite value at a stage of the step (inside its body?)"
+        )
 
     @staticmethod
     def _buffers(cap: int, n: int, nr: int, n_aux: int) -> _Buffers:
         return np.empty(cap), np.empty((cap, n)), np.empty((cap, nr, 4, 4)), np.empty((cap, n_aux))
-
-    def _hand_over(
-        self,
-        state0: State,
-        t_end: float,
-        Y: FloatArray,
-        G0: FloatArray,
-        h: float,
-        ints: np.ndarray,
-        outs: FloatArray | None,
-        rec: _Recorder,
-        max_steps: int,
-        bar: _Progress,
-        resume: dict[str, Any] | None,
-    ) -> None:
-        """Continue in the Python loop from the last accepted step (after a failure), or
-        from the start when the compiled loop failed before its first step."""
-        if resume is None and ints[_compiled.I_STEPS] == 0:
-            rec.rows.clear()
-            rec.blocks.clear()
-            self.p.n_rhs = 0
-            _Stepper.run(self, state0, t_end, outs, rec, max_steps, bar)
-            return
-        record = resume or {}
-        if ints[_compiled.I_STEPS] > int(record.get("n_steps", -1)):
-            record = {
-                "t": self.t,
-                "G0": G0.ravel().tolist(),
-                "Y": Y.tolist(),
-                "n_rhs": int(ints[_compiled.I_RHS]),
-                "n_steps": int(ints[_compiled.I_STEPS]),
-                "n_rejected": int(ints[_compiled.I_REJECTED]),
-                "out_i": int(ints[_compiled.I_OUT]),
-                "h": h,
-            }
-        _Stepper.run(self, state0, t_end, outs, rec, max_steps, bar, resume=record)

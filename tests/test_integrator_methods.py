@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import gmuk
-from gmuk import integrate
+from gmuk import integrate, testing
 from gmuk.errors import DefinitionError
 from gmuk.integrators import (
     DOP853,
@@ -352,7 +352,7 @@ def test_error_weights_of_a_point_mass_are_norms_and_do_not_depend_on_the_axes()
             s={"s": -0.25},
             s_dot={"s": 0.5},
         )
-        prob = integrate._Problem(system)
+        prob = testing._ReferenceProblem(system)
         Y = prob.pack(state)
         sc = prob.scale(Y, Y, state.g, rtol, atol)
         weights.append(sc)
@@ -367,7 +367,7 @@ def test_error_weights_of_a_point_mass_are_norms_and_do_not_depend_on_the_axes()
 def test_error_weights_take_the_larger_norm_at_the_two_ends_of_the_step():
     pm = gmuk.PointMass("p", 1.0)
     system = gmuk.System([pm])
-    prob = integrate._Problem(system)
+    prob = testing._ReferenceProblem(system)
     s0 = system.state(r={"p": [1.0, 0.0, 0.0]}, v={"p": [0.0, 2.0, 0.0]})
     s1 = system.state(r={"p": [0.0, 0.0, -3.0]}, v={"p": [0.0, 0.0, 0.5]})
     sc = prob.scale(prob.pack(s0), prob.pack(s1), s0.g, 1e-3, 1e-9)

@@ -26,7 +26,6 @@ from gmuk.campaign import store as _store
 from gmuk.campaign.dispersions import Dispersion, check_sequence, dispersion_from_dict, magnitude
 from gmuk.campaign.models import CampaignModel, FunctionModel, get_model, model_from_dict
 from gmuk.errors import DefinitionError, GmukError
-from gmuk.integrators import _compiled
 
 __all__ = ["Campaign", "CampaignReport", "resume"]
 
@@ -361,11 +360,7 @@ def execute(campaign: Campaign, k: int, out: str | None) -> dict[str, Any]:
     params = campaign.parameters(k)
     record |= _flatten(campaign, params)
     try:
-        # Every run takes the compiled loop when its System qualifies, compiling it first if
-        # this machine has not (once; workers wait for one another): a run's result must not
-        # depend on when a background compilation ends.
-        with _compiled.compiling_on_first_use():
-            traj, metrics = campaign.campaign_model.run(params)
+        traj, metrics = campaign.campaign_model.run(params)
         if traj is not None and traj.status != "success":
             record["status"] = traj.status
             record["error"] = traj.message

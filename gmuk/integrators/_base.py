@@ -72,6 +72,13 @@ class RungeKuttaMethod:
         onto them (:attr:`steps_onto_outputs`).
     n_stages : int
         s, the number of stages of one step (derived).
+    safety, min_factor, max_factor, max_factor_rejected, error_floor : float
+        The step-size controller (adaptive methods): after a step with scaled error
+        estimate err (1: at tolerance) the step is scaled by
+        ``safety · max(err, error_floor)^(−1/order)``, clipped to [min_factor, max_factor]
+        after an accepted step and to [min_factor, max_factor_rejected] for the retry of a
+        rejected one (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4). A subclass may set
+        its own.
     """
 
     name: ClassVar[str]
@@ -84,6 +91,11 @@ class RungeKuttaMethod:
     dense_output: ClassVar[bool] = False
     adaptive: ClassVar[bool] = False
     n_stages: ClassVar[int] = 0
+    safety: ClassVar[float] = 0.9
+    min_factor: ClassVar[float] = 0.2
+    max_factor: ClassVar[float] = 10.0
+    max_factor_rejected: ClassVar[float] = 0.9
+    error_floor: ClassVar[float] = 1e-10
     # (A[i, :i], c[i]) for the stages i ≥ 1, and the number of rows of the stage array.
     _rows: ClassVar[tuple[tuple[FloatArray, float], ...] | None] = None
     _n_rows: ClassVar[int] = 0

@@ -1,47 +1,46 @@
-"""The compiled step loop: the RKMK integrator of :mod:`gmuk.integrate`, run in machine code
-for a System of rigid bodies, point masses and slack coordinates.
+"""The compiled step loop: gmuk's one integrator loop, the RKMK method of :mod:`gmuk.integrate`
+run in machine code.
 
-The parts that have compiled forms run compiled: the built-in gravity, uniform-gravity and
-linear spring–damper models (``ForceModel._compiled_term``, unless a subclass overrides
-their methods), LVLH configuration tracking and relative constraints on rigid bodies, the
-corrected Morse–Lyapunov law on an LVLH reference (``Controller._compiled_term``), the
-free acceleration and the Udwadia–Kalaba solve of the ``"fused"`` and ``"dense"`` strategies
-(the certified QR solve; a state whose rows it cannot certify is handed to the Python
-loop). Every other force model, constraint and controller is called in Python from inside
-the loop through a C callback (:class:`PythonParts`): only those parts cost Python time.
-Systems with constraints under another solve strategy (sparse, Eq. 80, a user's) or a
-System subclass that overrides ``accelerations`` run the Python loop. The
-method must be one whose step is its tableau (every
-:class:`~gmuk.integrators.RungeKuttaMethod` that keeps the base class's ``stages``,
-``error_norm`` and has no continuous extension of its own) or DOP853 itself.
-:func:`program` derives the compiled form from the parts once per call of ``simulate``; the
-parts stay the objects the user built.
+Every System runs here. The parts that have compiled forms run compiled: the built-in
+gravity, uniform-gravity and linear spring–damper models (``ForceModel._compiled_term``,
+unless a subclass overrides their methods), LVLH configuration tracking and relative
+constraints on rigid bodies, the corrected Morse–Lyapunov law on an LVLH reference
+(``Controller._compiled_term``), the free acceleration and the Udwadia–Kalaba solve of the
+``"fused"`` and ``"dense"`` strategies. Everything else is called back in Python from inside
+the loop through a C function (:class:`PythonParts`), and costs only its own Python:
 
-The loop is the Python loop of :class:`gmuk.integrate._Stepper` statement for statement (step
-control, landing on output times, the continuous extension and its error control, the base
-pose update with its Newton–Schulz step, the reuse of the last evaluation's accelerations at
-the step end). It runs a chunk of steps and returns, so that Python can see stop requests,
-write checkpoints and drain the output buffers between chunks; the results agree with the
-Python loop's to rounding (sums in another order), which the tests check on every built-in
-part. It is compiled once per machine (:func:`compile_loop`) and loaded from numba's cache
-by later processes (:func:`loaded`).
+* force models, constraints and controllers without a compiled form (phases
+  :data:`PHASE_LOADS` and :data:`PHASE_CONTROLS`);
+* the whole acceleration, ``System._accelerations`` (:data:`PHASE_ACCELERATIONS`), for a
+  System whose solve strategy has no compiled form (sparse, Eq. 80, a user's), for a System
+  subclass with its own ``accelerations``, and for a state at which the compiled QR solve
+  cannot certify its answer (rank-deficient or ill-conditioned rows): the strategy's own
+  Python solve decides there, as it does in :meth:`System.accelerations`.
+
+The method is read from the method object (:class:`MethodTable`): its tableau, its
+step-size controller's constants and, for DOP853, its continuous extension and defect
+control. A method that replaces the tableau's step with its own Python (``stages``,
+``error_norm``, ``interpolant``) cannot run here; :func:`program` says so.
+
+The loop runs a chunk of steps and returns, so that Python can see stop requests, write
+checkpoints and drain the output buffers between chunks. It is compiled once per machine,
+in the foreground, announced on stderr (:func:`compile_loop`), and loaded from numba's cache
+by later processes: the same inputs give the same bits whether the cache was cold or warm.
 """
 
 from __future__ import annotations
 
 import contextlib
 import ctypes
-import hashlib
+import enum
 import math
 import os
-import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from llvmlite import ir
@@ -52,7 +51,7 @@ from gmuk._numba import njit
 from gmuk._uk_kernels import _qr_solve, relative_rows, rigid_free_accel, tracking_b, uk_rigid
 from gmuk.bodies import BodyKind
 from gmuk.control._kernels import apply_control
-from gmuk.errors import ConstraintError
+from gmuk.errors import ConstraintError, DefinitionError
 from gmuk.forces._kernels import apply_term
 from gmuk.gravity import _kernels as _field_kernels
 from gmuk.integrators import _dop853_tableau as _tab
@@ -71,102 +70,368 @@ if TYPE_CHECKING:
     from gmuk.state import State
     from gmuk.system import System
 
-__all__ = ["Program", "compile_loop", "loaded", "program"]
+__all__ = ["MethodTable", "Parts", "Program", "Status", "compile_loop", "loaded", "program"]
 
-# Status codes of :func:`advance`.
-DONE = 0  #: reached the end time
-PAUSE = 1  #: ran its chunk of steps
-FULL = 2  #: the output buffers have no room for the next step's outputs
-NONFINITE = -1  #: a derivative with NaN or inf
-UNDERFLOW = -2  #: step size underflow
-MAX_STEPS = -3  #: max_steps reached
-FIELD = -4  #: a force kernel's failure (its status in ints[I_FIELD])
 
-# Entries of the integer and float state vectors shared with Python.
-I_OUT, I_STEPS, I_REJECTED, I_RHS, I_WRITTEN, I_MAX_STEPS, I_CHUNK, I_FIELD, I_NEED = range(9)
-F_T, F_H, F_END, F_RTOL, F_ATOL, F_MAX_STEP, F_BAD_T = range(7)
+class Status(enum.IntEnum):
+    """What :func:`advance` and :func:`rhs` return."""
+
+    DONE = 0  #: reached the end time (rhs: evaluated)
+    PAUSE = 1  #: ran its chunk of steps
+    FULL = 2  #: the output buffers have no room for the next step's outputs
+    NONFINITE = -1  #: a derivative with NaN or inf
+    UNDERFLOW = -2  #: step size underflow
+    MAX_STEPS = -3  #: max_steps reached
+    FIELD = -4  #: a compiled force term failed (its kernel's code in ints[I_FIELD])
+    CALLBACK = -5  #: a part evaluated in Python raised (PythonParts.error holds it)
+
+
+# The statuses as plain ints for the kernels.
+DONE, PAUSE, FULL = int(Status.DONE), int(Status.PAUSE), int(Status.FULL)
+NONFINITE, UNDERFLOW = int(Status.NONFINITE), int(Status.UNDERFLOW)
+MAX_STEPS, FIELD, CALLBACK = int(Status.MAX_STEPS), int(Status.FIELD), int(Status.CALLBACK)
+
+# Entries of the integer and float state vectors shared between the loop and its driver.
+I_OUT = 0  #: the next output time's index
+I_STEPS = 1  #: accepted steps
+I_REJECTED = 2  #: rejected steps
+I_RHS = 3  #: right-hand side evaluations
+I_WRITTEN = 4  #: rows written to the output buffers in this chunk
+I_MAX_STEPS = 5  #: the step budget
+I_CHUNK = 6  #: steps per chunk
+I_FIELD = 7  #: a failed force kernel's code
+I_NEED = 8  #: output rows the next step needs (status FULL)
+I_STARTED = 9  #: 0 until the first evaluation at the start time is done
+I_FRESH = 10  #: 1 for a run from its initial state, 0 for one resumed from a checkpoint
+N_INTS = 11
+F_T = 0  #: time of the last accepted step (s)
+F_H = 1  #: the next step size (s); 0 asks the loop for the starting step
+F_END = 2  #: end time (s)
+F_RTOL = 3
+F_ATOL = 4
+F_MAX_STEP = 5
+F_FIRST_STEP = 6  #: the user's first step (s), 0 if none
+F_BAD_T = 7  #: the time of a failed evaluation (s)
+N_FLOATS = 8
+
+# How the right-hand side solves (Dims.solve).
+FREE = 0  #: no constraints: the free acceleration
+FUSED = 1  #: FusedRigidSolver: free acceleration, QR solve and wrenches in one call
+DENSE = 2  #: DenseSolver: the free acceleration, then the certified QR solve
+PYTHON_SOLVE = 3  #: the System's own Python accelerations at every evaluation
+
+# The phases of the Python callback (PythonParts).
+PHASE_LOADS = 0  #: loads and rows of the parts without a compiled form
+PHASE_CONTROLS = 1  #: the controllers without a compiled form
+PHASE_ACCELERATIONS = 2  #: the whole acceleration in Python (System._accelerations)
+
+
+class Dims(NamedTuple):
+    """Sizes and switches of a program (all int)."""
+
+    n_rigid: int
+    n_euclid: int
+    n_dof: int
+    #: unmodeled loads or controllers act on the plant beyond the solve (1) or not (0)
+    plant_only: int
+    #: constraint rows s
+    n_rows: int
+    #: address of the Python callback (PythonParts)
+    callback: int
+    n_control: int
+    #: where the controllers' phase reads and writes ``io`` (0: no controller in Python)
+    controls_at: int
+    #: FREE, FUSED, DENSE or PYTHON_SOLVE
+    solve: int
+    #: where the Python loads start in ``io``
+    loads_at: int
+    #: where the Python accelerations (the layout of rhs's outputs) start in ``io``
+    accel_at: int
+    #: whether any force model, constraint row or controller is evaluated in Python
+    python_parts: int
+    #: the rank reported without constraints (the solve's own, −1 for none)
+    free_rank: int
+
+
+class Parts(NamedTuple):
+    """A System's compiled form, as the kernels take it."""
+
+    #: (n_terms, 8) int64: code, rigid, body index, ν offset, modeled, parameter start,
+    #: field start, field end
+    terms: np.ndarray
+    params: np.ndarray
+    field_data: np.ndarray
+    J: np.ndarray  #: (n_r, 3, 3) central inertias (kg·m², body frame)
+    Jinv: np.ndarray
+    m_rigid: np.ndarray
+    m_euclid: np.ndarray  #: per Euclidean coordinate
+    rigid_offsets: np.ndarray  #: each rigid body's first entry of ν
+    euclid_offsets: np.ndarray  #: each Euclidean coordinate's entry of ν
+    dims: Dims
+    #: (n_c, 6) int64: kind, body, other body, first row, rows, parameter start
+    cons: np.ndarray
+    cparams: np.ndarray
+    #: the solve's packed constants (FusedRigidSolver's, or the dense solve's)
+    uk_params: np.ndarray
+    #: the buffer shared with the Python callback
+    io: np.ndarray
+    #: (n_ctrl, 5) int64: code, body index, ν offset, z offset, parameter start
+    ctrls: np.ndarray
+    ctrl_params: np.ndarray
+    #: where the point masses' 3-vectors start in Y (positions, then velocities)
+    point_starts: np.ndarray
+
+
+class MethodTable(NamedTuple):
+    """A Runge–Kutta method as the loop reads it, from the method object."""
+
+    A: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    E: np.ndarray
+    E3: np.ndarray  #: DOP853's order-3 estimate (zeros otherwise)
+    A_ext: np.ndarray  #: DOP853's extended stages (the full tableau)
+    c_ext: np.ndarray
+    D: np.ndarray  #: DOP853's continuous-extension coefficients
+    n_stages: int
+    n_rows: int
+    fsal: bool
+    adaptive: bool
+    order: int
+    dop853: bool
+    dense: bool
+    safety: float
+    min_factor: float
+    max_factor: float
+    max_factor_rejected: float
+    error_floor: float
+    e3_weight: float
+    defect_node: float
+    defect_gain: float
 
 
 @dataclass(frozen=True)
 class Program:
-    """The compiled form of a System and a method (see the module docstring).
+    """The compiled form of a System and a method (see the module docstring)."""
 
-    ``parts`` is the tuple the kernels take: (terms (n_terms, 8) int64 — code, rigid, body
-    index, ν offset, modeled, parameter start, field start, field end —, parameters, field
-    data, J (n_r, 3, 3), J⁻¹, rigid masses, Euclidean masses per entry, rigid ν offsets,
-    Euclidean ν offsets, dims [n_r, n_e, n_dof, plant-only loads]). ``method`` is (A, b, c,
-    E, E3, A_ext, c_ext, D, ints [s, rows, fsal, adaptive, order, dop853, dense]).
-    """
-
-    parts: tuple[Any, ...]
-    method: tuple[Any, ...]
+    parts: Parts
+    method: MethodTable
+    #: length of the integrator's state Y
     n: int
     #: rows of the stacked constraints
     s: int
-    #: the parts evaluated in Python through the C callback (None: every part is compiled)
-    python: PythonParts | None = None
+    #: the Python callback (force models, constraints, controllers or the solve)
+    python: PythonParts
 
     @property
     def n_aux(self) -> int:
-        """Length of :func:`rhs`'s other outputs: total, unmodeled, constraint acceleration,
-        constraint force (n_dof each), λ (s), the residual, the control (n_dof), ż."""
-        dims = self.parts[9]
-        return int(5 * dims[2] + self.s + 1 + dims[6])
+        """Length of :func:`rhs`'s other outputs (:func:`aux_layout`)."""
+        return aux_size(self.parts.dims.n_dof, self.s, self.parts.dims.n_control)
 
 
-def _generic(method: RungeKuttaMethod) -> bool:
+def aux_size(n_dof: int, s: int, n_control: int) -> int:
+    """Length of :func:`rhs`'s other outputs: the total acceleration, the unmodeled generalized
+    forces, the constraint acceleration and the constraint forces M ν̇_c (n_dof each), λ (s),
+    the residual, the controls (n_dof), ż (n_c) and the rank of A (−1: none)."""
+    return 5 * n_dof + s + 2 + n_control
+
+
+def aux_layout(n_dof: int, s: int, n_control: int) -> dict[str, slice | int]:
+    """Where each of :func:`rhs`'s other outputs sits (see :func:`aux_size`)."""
+    nd = n_dof
+    return {
+        "acceleration": slice(0, nd),
+        "unmodeled_force": slice(nd, 2 * nd),
+        "constraint_acceleration": slice(2 * nd, 3 * nd),
+        "constraint_force": slice(3 * nd, 4 * nd),
+        "multipliers": slice(4 * nd, 4 * nd + s),
+        "residual": 4 * nd + s,
+        "control_force": slice(4 * nd + s + 1, 5 * nd + s + 1),
+        "z_dot": slice(5 * nd + s + 1, 5 * nd + s + 1 + n_control),
+        "rank": 5 * nd + s + 1 + n_control,
+    }
+
+
+def own_step_methods(method: RungeKuttaMethod) -> list[str]:
+    """The step methods a method class replaces with its own Python (empty for a tableau
+    method and for DOP853 itself)."""
     cls = type(method)
-    return (
-        cls.stages is RungeKuttaMethod.stages
-        and cls.error_norm is RungeKuttaMethod.error_norm
-        and not method.dense_output
+    if cls is DOP853:
+        return []
+    names = ("stages", "error_norm", "interpolant", "interpolant_error")
+    return [n for n in names if getattr(cls, n) is not getattr(RungeKuttaMethod, n)]
+
+
+def method_table(method: RungeKuttaMethod) -> MethodTable:
+    """The loop's view of ``method`` (writable copies: every program has the same types)."""
+    own = own_step_methods(method)
+    if own:
+        raise DefinitionError(
+            f"the method {type(method).__qualname__} replaces {', '.join(own)} with its own "
+            "Python; gmuk's loop runs explicit Runge–Kutta tableaus (A, b, c, E) and DOP853"
+        )
+    dop853 = isinstance(method, DOP853)
+    n_rows = method._n_rows
+    E = np.zeros(n_rows) if method.E is None else np.array(method.E, dtype=float)
+    zeros = np.zeros(n_rows)
+    return MethodTable(
+        A=np.array(method.A, dtype=float, order="C"),
+        b=np.array(method.b, dtype=float),
+        c=np.array(method.c, dtype=float),
+        E=E,
+        E3=np.array(DOP853.E3 if dop853 else zeros, dtype=float),
+        A_ext=np.array(DOP853.A_extended, dtype=float, order="C"),
+        c_ext=np.array(DOP853.c_extended, dtype=float),
+        D=np.array(DOP853.D, dtype=float, order="C"),
+        n_stages=int(method.n_stages),
+        n_rows=int(n_rows),
+        fsal=bool(method.fsal),
+        adaptive=bool(method.adaptive),
+        order=int(method.order),
+        dop853=dop853,
+        dense=bool(method.dense_output and dop853),
+        safety=float(method.safety),
+        min_factor=float(method.min_factor),
+        max_factor=float(method.max_factor),
+        max_factor_rejected=float(method.max_factor_rejected),
+        error_floor=float(method.error_floor),
+        e3_weight=float(DOP853.e3_weight),
+        defect_node=float(DOP853.defect_node),
+        defect_gain=float(DOP853.defect_gain),
     )
 
 
-def program(system: System, method: RungeKuttaMethod, state: State | None = None) -> Program | str:
-    """The compiled form of ``system`` with ``method``, or why there is none (a sentence).
+def _solve_mode(system: System) -> tuple[int, str]:
+    """How the loop solves this System, and why it is PYTHON_SOLVE when it is."""
+    from gmuk.solvers import DenseSolver, FusedRigidSolver
+    from gmuk.system import System as _System
 
-    Force models and constraints without a compiled form are evaluated in Python through a
-    C callback (:class:`PythonParts`); the row counts of such constraints are read at
-    ``state`` (the initial state), without which they make the System ineligible."""
+    if type(system).accelerations is not _System.accelerations:
+        return PYTHON_SOLVE, "the System subclass has its own accelerations"
+    if not system.constraints:
+        return FREE, ""
+    if type(system.solver) is FusedRigidSolver:
+        return FUSED, ""
+    if type(system.solver) is DenseSolver:
+        return DENSE, ""
+    return PYTHON_SOLVE, f"the constraints are solved by {type(system.solver).__name__}"
+
+
+def program(system: System, method: RungeKuttaMethod, state: State) -> Program:
+    """The compiled form of ``system`` with ``method``, for a run from ``state``.
+
+    Parts without a compiled form are called back in Python (:class:`PythonParts`); the row
+    counts of such constraints (and of a solve done in Python) are read at ``state``.
+
+    Raises
+    ------
+    DefinitionError
+        When the method replaces the tableau's step with its own Python.
+    Exception
+        Whatever a part raises when its rows are evaluated at ``state`` (the caller reports
+        it as the run's failure at the start).
+    """
     from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS
-    from gmuk.system import System, _pair
+    from gmuk.system import _pair
 
-    if type(system).accelerations is not System.accelerations:
-        return "the System subclass overrides accelerations"
-    if type(system.solver).__module__ != "gmuk.solvers":
-        return f"the solve strategy {type(system.solver).__name__} is not a built-in one"
-    cons, cparams, uk_params, solve = _constraint_program(system)
-    if isinstance(cons, str):
-        return cons
+    meth = method_table(method)
     lay = system.layout
+    nr, ne, nd, nc = lay.n_rigid, lay.n_euclid, lay.n_dof, lay.n_control
+    solve, _ = _solve_mode(system)
     kinds = (BodyKind.RIGID, BodyKind.POINT, BodyKind.SLACK)
-    bad = [b.name for b in system.bodies if b.kind not in kinds]
-    if bad:
-        return f"bodies {bad} are not rigid bodies, point masses or slack coordinates"
-    dop853 = type(method) is DOP853
-    if not dop853 and not _generic(method):
-        return f"the method {type(method).__name__} defines its own step or output"
-    py_constraints = [k for k in range(cons.shape[0]) if cons[k, 0] == PYTHON]
-    if py_constraints:
-        if state is None:
-            return "constraints without a compiled form need the initial state for their rows"
+    if any(b.kind not in kinds for b in system.bodies):
+        solve = PYTHON_SOLVE
+    free_rank = -1
+    cons = np.zeros((0, 6), dtype=np.int64)
+    cparams, uk_params = np.zeros(1), np.zeros(1)
+    py_constraints: list[int] = []
+    if solve != PYTHON_SOLVE:
+        cons, cparams, uk_params = _constraint_program(system, solve)
+        py_constraints = [k for k in range(cons.shape[0]) if cons[k, 0] == PYTHON]
         row = 0
         for k in range(cons.shape[0]):
             cons[k, 3] = row
             if cons[k, 0] == PYTHON:
-                c = system.constraints[k]
-                try:
-                    _, b = _pair(c, state)
-                    cons[k, 4] = np.asarray(b).reshape(-1).size
-                except Exception as exc:  # the Python loop reports it
-                    return f"constraint {c.name!r} failed at the initial state ({exc})"
+                _, b = _pair(system.constraints[k], state)
+                cons[k, 4] = np.asarray(b).reshape(-1).size
             row += cons[k, 4]
-    terms: list[list[int]] = []
-    params: list[float] = []
-    fields: list[np.ndarray] = []
-    field_at: dict[int, tuple[int, int]] = {}
-    n_field = 0
+        n_rows = int(cons[:, 4].sum())
+        if solve == DENSE and n_rows > QR_MAX_ROWS:  # more than the certified QR takes
+            solve = PYTHON_SOLVE
+    if solve == PYTHON_SOLVE:
+        n_rows = int(system._accelerations(state).multipliers.size)
+        cons = np.zeros((0, 6), dtype=np.int64)
+        cparams, uk_params = np.zeros(1), np.zeros(1)
+        terms_plan: list[Any] = []
+        py_forces: list[Any] = []
+        py_constraints = []
+        ctrl_plan: list[tuple[int, Any]] = []
+        py_controllers: list[int] = []
+    else:
+        if solve == FREE:
+            rank = system._accelerations(state).rank
+            free_rank = -1 if rank is None else int(rank)
+        terms_plan, py_forces = _force_plan(system)
+        ctrl_plan, py_controllers = _controller_plan(system)
+    terms, params, field_data = _pack_terms(terms_plan)
+    if solve == DENSE:  # DenseSolver.solve_rows: the QR's condition limit for these rows
+        rcond = system.rcond
+        if rcond is None:
+            rcond = max(n_rows, nd) * float(np.finfo(float).eps)
+        uk_params[0] = min(QR_COND_LIMIT, 0.1 / rcond)
+    ctrl_rows: list[list[int]] = []
+    ctrl_params: list[float] = []
+    for k, (code, values) in ctrl_plan:
+        body = system._ctrl_bodies[k][0]
+        slot = lay.slot(body)
+        z0 = int(system._ctrl_slices[k].start)
+        ctrl_rows.append([code, slot.index, slot.offset, z0, len(ctrl_params)])
+        ctrl_params.extend(np.asarray(values, dtype=float).tolist())
+    python = PythonParts(system, py_forces, cons, py_constraints, py_controllers, n_rows)
+    points = [lay.slot(b).index for b in system.bodies if b.kind is BodyKind.POINT]
+    point_starts = [12 * nr + half * ne + i for half in (0, 1) for i in points]
+    dims = Dims(
+        n_rigid=nr,
+        n_euclid=ne,
+        n_dof=nd,
+        plant_only=int(system._plant_only_loads),
+        n_rows=n_rows,
+        callback=python.address,
+        n_control=nc,
+        controls_at=python.controls_at if py_controllers else 0,
+        solve=solve,
+        loads_at=python.loads_at,
+        accel_at=python.accel_at,
+        python_parts=int(bool(py_forces or py_constraints or py_controllers)),
+        free_rank=free_rank,
+    )
+    parts = Parts(
+        terms=terms,
+        params=params,
+        field_data=field_data,
+        J=np.ascontiguousarray(system._J, dtype=float).reshape(nr, 3, 3),
+        Jinv=np.ascontiguousarray(system._Jinv, dtype=float).reshape(nr, 3, 3),
+        m_rigid=np.ascontiguousarray(system._m_rigid, dtype=float).reshape(nr),
+        m_euclid=np.ascontiguousarray(system._m_euclid, dtype=float).reshape(ne),
+        rigid_offsets=np.asarray(lay.rigid_offsets, dtype=np.int64),
+        euclid_offsets=np.asarray(lay.euclid_offsets, dtype=np.int64),
+        dims=dims,
+        cons=cons,
+        cparams=cparams,
+        uk_params=uk_params,
+        io=python.io,
+        ctrls=np.array(ctrl_rows, dtype=np.int64).reshape(-1, 5),
+        ctrl_params=np.array([*ctrl_params, 0.0], dtype=float),
+        point_starts=np.array(point_starts, dtype=np.int64),
+    )
+    return Program(parts, meth, 12 * nr + 2 * ne + nc, n_rows, python)
+
+
+def _force_plan(system: System) -> tuple[list[tuple[Any, ...]], list[Any]]:
+    """The compiled terms ``(code, values, data, rigid, index, offset, modeled)`` of the force
+    models that have a compiled form on every body they act on, and the other models'
+    entries of the System's force plan (evaluated in Python)."""
+    terms: list[tuple[Any, ...]] = []
     py_forces = []
     for entry in system._force_plan:
         f, _bodies, slots = entry
@@ -177,111 +442,49 @@ def program(system: System, method: RungeKuttaMethod, state: State | None = None
         for (_body, rigid, index, offset, _dof), term in zip(slots, compiled_terms, strict=True):
             assert term is not None
             code, values, data = term
-            f0 = f1 = 0
-            if data is not None:
-                if id(data) not in field_at:
-                    field_at[id(data)] = (n_field, n_field + data.size)
-                    fields.append(np.asarray(data, dtype=float))
-                    n_field += data.size
-                f0, f1 = field_at[id(data)]
-            terms.append([code, int(rigid), index, offset, int(f.modeled), len(params), f0, f1])
-            params.extend(float(v) for v in values)
-    nr, ne = lay.n_rigid, lay.n_euclid
+            terms.append((code, values, data, rigid, index, offset, f.modeled))
+    return terms, py_forces
+
+
+def _pack_terms(plan: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The term table, parameters and shared field data of :func:`_force_plan`'s terms."""
+    terms: list[list[int]] = []
+    params: list[float] = []
+    fields: list[np.ndarray] = []
+    field_at: dict[int, tuple[int, int]] = {}
+    n_field = 0
+    for code, values, data, rigid, index, offset, modeled in plan:
+        f0 = f1 = 0
+        if data is not None:
+            if id(data) not in field_at:
+                field_at[id(data)] = (n_field, n_field + data.size)
+                fields.append(np.asarray(data, dtype=float))
+                n_field += data.size
+            f0, f1 = field_at[id(data)]
+        terms.append([code, int(rigid), index, offset, int(modeled), len(params), f0, f1])
+        params.extend(float(v) for v in values)
     field_data = np.concatenate(fields) if fields else np.zeros(1)
     field_data.setflags(write=False)
-    n_rows = int(cons[:, 4].sum())
-    if solve == DENSE:  # DenseSolver.solve_rows: QR up to QR_MAX_ROWS rows, certified
-        if n_rows > QR_MAX_ROWS:
-            return f"more than {QR_MAX_ROWS} constraint rows under the dense solve"
-        rcond = system.rcond
-        if rcond is None:
-            rcond = max(n_rows, lay.n_dof) * float(np.finfo(float).eps)
-        uk_params[0] = min(QR_COND_LIMIT, 0.1 / rcond)
-    nc = lay.n_control
-    ctrl_rows: list[list[int]] = []
-    ctrl_params: list[float] = []
-    py_controllers = []
-    for k, ctl in enumerate(system.controllers):
-        term = ctl._compiled_term()
-        body = system._ctrl_bodies[k][0] if len(system._ctrl_bodies[k]) == 1 else None
-        if term is None or body is None or body.kind is not BodyKind.RIGID:
-            py_controllers.append(k)
-            continue
-        slot = lay.slot(body)
-        code, values = term
-        z0 = int(system._ctrl_slices[k].start)
-        ctrl_rows.append([code, slot.index, slot.offset, z0, len(ctrl_params)])
-        ctrl_params.extend(np.asarray(values, dtype=float).tolist())
-    python = None
-    if py_forces or py_constraints or py_controllers:
-        python = PythonParts(system, py_forces, cons, py_constraints, py_controllers)
-    io = python.io if python is not None else np.zeros(1)
-    callback = python.address if python is not None else 0
-    loads_at = python.loads_at if python is not None else 0
-    controls_at = python.controls_at if python is not None and py_controllers else 0
-    points = [lay.slot(b).index for b in system.bodies if b.kind is BodyKind.POINT]
-    point_starts = [12 * nr + half * ne + i for half in (0, 1) for i in points]
-    parts = (
+    return (
         np.array(terms, dtype=np.int64).reshape(-1, 8),
         np.array([*params, 0.0], dtype=float),
         field_data,
-        np.ascontiguousarray(system._J, dtype=float).reshape(nr, 3, 3),
-        np.ascontiguousarray(system._Jinv, dtype=float).reshape(nr, 3, 3),
-        np.ascontiguousarray(system._m_rigid, dtype=float).reshape(nr),
-        np.ascontiguousarray(system._m_euclid, dtype=float).reshape(ne),
-        np.asarray(lay.rigid_offsets, dtype=np.int64),
-        np.asarray(lay.euclid_offsets, dtype=np.int64),
-        np.array(
-            [
-                nr,
-                ne,
-                lay.n_dof,
-                int(system._plant_only_loads),
-                n_rows,
-                callback,
-                nc,
-                controls_at,
-                solve,
-                loads_at,
-            ],
-            dtype=np.int64,
-        ),
-        cons,
-        cparams,
-        uk_params,
-        io,
-        np.array(ctrl_rows, dtype=np.int64).reshape(-1, 5),
-        np.array([*ctrl_params, 0.0], dtype=float),
-        # the point masses' 3-vectors in Y (positions, then velocities), for the error weights
-        np.array(point_starts, dtype=np.int64),
     )
-    s = method.n_stages
-    E = np.zeros(method._n_rows) if method.E is None else np.asarray(method.E, dtype=float)
-    ints = np.array(
-        [
-            s,
-            method._n_rows,
-            int(method.fsal),
-            int(method.adaptive),
-            method.order,
-            int(dop853),
-            int(method.dense_output),
-        ],
-        dtype=np.int64,
-    )
-    # writable copies: every program has the same argument types (one compiled loop)
-    meth = (
-        np.array(method.A, dtype=float, order="C"),
-        np.array(method.b, dtype=float),
-        np.array(method.c, dtype=float),
-        np.array(E, dtype=float),
-        np.array(_tab.E3 if dop853 else np.zeros(method._n_rows), dtype=float),
-        np.array(_tab.A, dtype=float, order="C"),
-        np.array(_tab.C, dtype=float),
-        np.array(_tab.D, dtype=float, order="C"),
-        ints,
-    )
-    return Program(parts, meth, 12 * nr + 2 * ne + nc, n_rows, python)
+
+
+def _controller_plan(system: System) -> tuple[list[tuple[int, Any]], list[int]]:
+    """The controllers with a compiled term on one rigid body ``(k, (code, values))``, and
+    the numbers of the others (called back in Python)."""
+    compiled: list[tuple[int, Any]] = []
+    python: list[int] = []
+    for k, ctl in enumerate(system.controllers):
+        term = ctl._compiled_term()
+        bodies = system._ctrl_bodies[k]
+        if term is None or len(bodies) != 1 or bodies[0].kind is not BodyKind.RIGID:
+            python.append(k)
+        else:
+            compiled.append((k, term))
+    return compiled, python
 
 
 #: The C signature of PythonParts' callback: int64 f(int64 phase), 0 on success.
@@ -289,20 +492,26 @@ _CALLBACK_TYPE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64)
 
 
 class PythonParts:
-    """The force models, constraints and controllers of a System that have no compiled form,
-    evaluated in Python when the compiled right-hand side calls back.
+    """What a program evaluates in Python when the compiled right-hand side calls back.
 
     The compiled loop writes the stage's state into ``io`` and calls a C function (a ctypes
-    callback to :meth:`_call`): in phase 0 this builds the :class:`~gmuk.State`, calls the
-    force models and constraints as the System does (``System._add_loads``, each
-    constraint's ``rows``) and writes their generalized forces and rows back into ``io``; in
-    phase 1, after the solve, it calls the controllers with the modeled acceleration
-    (``System._controls_of``). Layout of ``io``: t, g (16 n_r), V (6 n_r), x (n_e), ẋ (n_e),
-    z (n_c); from ``loads_at`` the modeled and unmodeled generalized forces (2 n_dof); from
-    ``controls_at`` the modeled acceleration (n_dof, in), the controls (n_dof) and ż (n_c);
-    then for each of these constraints its rows A (rows, n_dof) and b (rows), at the offset
-    the constraint table holds. Only such a part costs Python time; a part that raises makes
-    the loop stop with :data:`CALLBACK` and leaves the exception in ``error``.
+    callback to :meth:`_call`) with a phase:
+
+    * :data:`PHASE_LOADS`: builds the :class:`~gmuk.State`, calls the force models and
+      constraints without a compiled form as the System does (``System._add_loads``, each
+      constraint's ``rows``) and writes their generalized forces and rows into ``io``;
+    * :data:`PHASE_CONTROLS`, after the solve: the controllers without a compiled form, given
+      the modeled acceleration (``System._controls_of``);
+    * :data:`PHASE_ACCELERATIONS`: the whole acceleration, ``System._accelerations`` (or a
+      System subclass's own ``accelerations``), written in the layout of :func:`rhs`'s
+      outputs (:func:`aux_layout`).
+
+    Layout of ``io``: t, g (16 n_r), V (6 n_r), x (n_e), ẋ (n_e), z (n_c); from ``loads_at``
+    the modeled and unmodeled generalized forces (2 n_dof); from ``controls_at`` the modeled
+    acceleration (n_dof, in), the controls (n_dof) and ż (n_c); from ``accel_at`` the
+    accelerations of :data:`PHASE_ACCELERATIONS`; then for each constraint in Python its
+    rows A (rows, n_dof) and b (rows), at the offset the constraint table holds. A part that
+    raises makes the loop stop with :data:`CALLBACK` and leaves the exception in ``error``.
     """
 
     def __init__(
@@ -312,11 +521,17 @@ class PythonParts:
         cons: np.ndarray,
         constraints: list[int],
         controllers: list[int],
+        n_rows: int,
     ) -> None:
+        from gmuk.system import System as _System
+
         lay = system.layout
         nr, ne, nd, nc = lay.n_rigid, lay.n_euclid, lay.n_dof, lay.n_control
         self.system, self.forces, self.layout = system, forces, lay
         self.controllers = controllers
+        self.n_rows = n_rows
+        own = type(system).accelerations is not _System.accelerations
+        self._accelerations = system.accelerations if own else system._accelerations
         self._g = slice(1, 1 + 16 * nr)
         self._V = slice(1 + 16 * nr, 1 + 22 * nr)
         self._x = slice(1 + 22 * nr, 1 + 22 * nr + ne)
@@ -327,7 +542,9 @@ class PythonParts:
         ca = self.controls_at
         self._acc, self._control = slice(ca, ca + nd), slice(ca + nd, ca + 2 * nd)
         self._z_dot = slice(ca + 2 * nd, ca + 2 * nd + nc)
-        at = ca + 2 * nd + nc
+        self.accel_at = ca + 2 * nd + nc
+        self._layout = aux_layout(nd, n_rows, nc)
+        at = self.accel_at + aux_size(nd, n_rows, nc)
         self.constraints = []
         for k in constraints:
             rows = int(cons[k, 4])
@@ -353,14 +570,46 @@ class PythonParts:
 
     def _call(self, phase: int) -> int:
         try:
-            if phase == 0:
+            if phase == PHASE_LOADS:
                 self.evaluate()
-            else:
+            elif phase == PHASE_CONTROLS:
                 self.control()
+            else:
+                self.accelerations()
         except BaseException as exc:  # a C caller cannot take an exception: keep it
             self.error = exc
             return 1
         return 0
+
+    def state(self) -> State:
+        """The state the loop wrote into ``io``."""
+        io, lay = self.io, self.layout
+        return self._make_state(
+            float(io[0]),
+            io[self._g].reshape(lay.n_rigid, 4, 4).copy(),
+            io[self._V].reshape(lay.n_rigid, 6).copy(),
+            io[self._x].copy(),
+            io[self._xd].copy(),
+            io[self._z].copy(),
+            lay,
+        )
+
+    def accelerations(self) -> None:
+        """The System's accelerations at the state in ``io``, into ``io`` from
+        ``accel_at`` in the layout of :func:`rhs`'s outputs."""
+        state = self.state()
+        acc = self._accelerations(state)
+        if acc.multipliers.size != self.n_rows:
+            raise ConstraintError(
+                f"the constraints gave {acc.multipliers.size} rows at t = {state.t:.9g} s and "
+                f"{self.n_rows} at the start; a run keeps its number of constraint rows"
+            )
+        out = self.io[self.accel_at :]
+        for name, where in self._layout.items():
+            if name == "rank":
+                out[where] = -1 if acc.rank is None else acc.rank
+            else:
+                out[where] = getattr(acc, _ACCELERATION_FIELDS.get(name, name))
 
     def control(self) -> None:
         """The controllers' generalized forces and internal-state rates at the state of the
@@ -376,15 +625,7 @@ class PythonParts:
     def evaluate(self) -> None:
         """The parts' loads and rows at the state in ``io``, into ``io``."""
         io, lay = self.io, self.layout
-        self._state = state = self._make_state(
-            float(io[0]),
-            io[self._g].reshape(lay.n_rigid, 4, 4).copy(),
-            io[self._V].reshape(lay.n_rigid, 6).copy(),
-            io[self._x].copy(),
-            io[self._xd].copy(),
-            io[self._z].copy(),
-            lay,
-        )
+        self._state = state = self.state()
         if self.forces:
             self._modeled[:] = 0.0
             self._unmodeled[:] = 0.0
@@ -396,13 +637,16 @@ class PythonParts:
             if bi.size != rows:
                 raise ConstraintError(
                     f"constraint {c.name!r} gave {bi.size} rows at t = {state.t:.9g} s and "
-                    f"{rows} at the start"
+                    f"{rows} at the start; a run keeps its number of constraint rows"
                 )
             block = io[at : at + rows * nd].reshape(rows, nd)
             block[:] = 0.0
             block[:, where] = Ai.toarray() if hasattr(Ai, "toarray") else Ai
             io[at + rows * nd : at + rows * (nd + 1)] = bi
 
+
+#: Accelerations' fields under the names of rhs's outputs (where they differ).
+_ACCELERATION_FIELDS = {"acceleration": "total", "constraint_acceleration": "constraint"}
 
 # Constraint kinds of the compiled right-hand side.
 TRACKING_LVLH = 0  #: ConfigurationTracking of an LVLHReference (Eq. 67), Baumgarte optional
@@ -423,26 +667,17 @@ def _gains(baumgarte: Any, n: int) -> list[float] | None:
     return [1.0, *alpha.tolist(), *beta.tolist()]
 
 
-def _constraint_program(system: System) -> tuple[Any, Any, Any, int]:
+def _constraint_program(system: System, solve: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(cons (n_c, 6) int64 — kind, body, other body, first row, rows, parameter start —,
-    parameters, the solve's packed constants, the solve: FREE, FUSED or DENSE), or (why
-    not, None, None, 0) for a solve strategy that is not compiled. The row counts of PYTHON
-    constraints are left to :func:`program`."""
+    parameters, the solve's packed constants) for the FREE, FUSED or DENSE solve. The row
+    counts of PYTHON constraints are left to :func:`program`."""
     from gmuk.constraints.relative import RelativeConstraint
     from gmuk.constraints.tracking import ConfigurationTracking
     from gmuk.orbits.lvlh import LVLHReference
-    from gmuk.solvers import QR_COND_LIMIT, DenseSolver, FusedRigidSolver
+    from gmuk.solvers import QR_COND_LIMIT
 
-    solver = system.solver
-    if not system.constraints:  # every strategy: the free acceleration, then the plant loads
-        return np.zeros((0, 6), dtype=np.int64), np.zeros(1), np.zeros(1), FREE
-    if type(solver) is FusedRigidSolver:
-        kind = FUSED
-    elif type(solver) is DenseSolver:
-        kind = DENSE
-    else:
-        why = f"the System's constraints are solved by {type(solver).__name__}, not compiled"
-        return why, None, None, 0
+    if solve == FREE:
+        return np.zeros((0, 6), dtype=np.int64), np.zeros(1), np.zeros(1)
     rows: list[list[int]] = []
     params: list[float] = []
     row = 0
@@ -474,25 +709,17 @@ def _constraint_program(system: System) -> tuple[Any, Any, Any, int]:
             params += [*gains[1 : 1 + S.shape[0]], *S.ravel()]
             rows.append([RELATIVE, idx[0], idx[1], row, S.shape[0], start])
             row += S.shape[0]
-    cons = np.array(rows, dtype=np.int64)
-    if isinstance(solver, FusedRigidSolver):
+    cons = np.array(rows, dtype=np.int64).reshape(-1, 6)
+    if solve == FUSED:
+        fused: Any = system.solver  # a FusedRigidSolver (see _solve_mode)
         # a writable copy: every program has the same argument types
-        return cons, np.array([*params, 0.0]), np.array(solver._params), kind
+        return cons, np.array([*params, 0.0]), np.array(fused._params)
     # P[0], the condition limit, depends on the row count: program() sets it
     P = [QR_COND_LIMIT, system.consistency_tol, *np.ravel(system._Minv_sqrt)]
-    return cons, np.array([*params, 0.0]), np.array(P, dtype=float), kind
+    return cons, np.array([*params, 0.0]), np.array(P, dtype=float)
 
 
 # ------------------------------------------------------------------------ right-hand side
-UK_FAILED = -5  #: the fused solve did not certify its answer (the Python loop decides)
-CALLBACK = -6  #: a part evaluated in Python raised (PythonParts.error holds the exception)
-
-# How the right-hand side solves (dims[8]).
-FREE = 0  #: no constraints: the free acceleration
-FUSED = 1  #: FusedRigidSolver: free acceleration, QR solve and wrenches in one call
-DENSE = 2  #: DenseSolver: the free acceleration, then the certified QR solve
-
-
 @intrinsic
 def _call_back(typingctx, address, phase):  # type: ignore[no-untyped-def]
     """Call the C function ``int64 f(int64 phase)`` at ``address`` (a ctypes callback)."""
@@ -505,17 +732,45 @@ def _call_back(typingctx, address, phase):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
-    """dY/dt at (t, Y) about the base poses G0 into ``dY``, and into ``aux`` (Program.n_aux)
-    the total acceleration, the unmodeled generalized forces, the constraint acceleration,
-    the constraint wrenches M ν̇_c, the multipliers λ (s), the solve's residual, the
-    controllers' generalized forces and their states' rates ż. Returns 0, NONFINITE,
-    UK_FAILED, CALLBACK, or −100 − the status of a failed force kernel."""
-    terms, params, fdata, J, Jinv, m_r, m_e, r_off, e_off, dims, cons, cparams, P, io = parts[:14]
-    ctrls, ctrl_params = parts[14], parts[15]
-    nr, ne, ndof, plant, s, nc = dims[0], dims[1], dims[2], dims[3], dims[4], dims[6]
+def _write_state(t, g, V, Y, d, io):  # type: ignore[no-untyped-def]
+    """The stage's state into ``io`` for the Python callback (PythonParts.state)."""
+    nr = d.n_rigid
+    io[0] = t
+    for k in range(nr):
+        for a in range(4):
+            for e in range(4):
+                io[1 + 16 * k + 4 * a + e] = g[k, a, e]
+        for i in range(6):
+            io[1 + 16 * nr + 6 * k + i] = V[k, i]
+    for i in range(2 * d.n_euclid + d.n_control):  # x, ẋ, z
+        io[1 + 22 * nr + i] = Y[12 * nr + i]
+
+
+@njit(cache=True)
+def _python_accelerations(parts, aux):  # type: ignore[no-untyped-def]
+    """The whole acceleration from Python (PHASE_ACCELERATIONS) into ``aux``; the state is
+    in ``io`` already. Returns the status."""
+    d = parts.dims
+    if _call_back(d.callback, PHASE_ACCELERATIONS) != 0:
+        return CALLBACK
+    io = parts.io
+    for i in range(aux.shape[0]):
+        aux[i] = io[d.accel_at + i]
+    return DONE
+
+
+@njit(cache=True)
+def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
+    """dY/dt at (t, Y) about the base poses G0 into ``dY``, and into ``aux`` the other outputs
+    (:func:`aux_layout`: total acceleration, unmodeled generalized forces, constraint
+    acceleration, constraint wrenches M ν̇_c, multipliers λ, the solve's residual, the
+    controllers' generalized forces, their states' rates ż, the rank of A). Returns a
+    :class:`Status`: DONE, NONFINITE, CALLBACK, or FIELD with the force kernel's code in
+    ``ints[I_FIELD]``."""
+    d = parts.dims
+    r_off, e_off, io = parts.rigid_offsets, parts.euclid_offsets, parts.io
+    nr, ne, ndof, s, nc = d.n_rigid, d.n_euclid, d.n_dof, d.n_rows, d.n_control
     total = aux[:ndof]
-    unmodeled = aux[ndof : 2 * ndof]
     xi = np.empty((nr, 6))
     V = np.empty((nr, 6))
     any_xi = False
@@ -528,6 +783,55 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
     g = np.empty((nr, 4, 4))
     if nr:
         _compose_exp_into(G0, xi, g)
+    x0 = 12 * nr
+    z_dot = aux[5 * ndof + s + 1 : 5 * ndof + s + 1 + nc]
+    if d.solve == PYTHON_SOLVE:
+        _write_state(t, g, V, Y, d, io)
+        status = _python_accelerations(parts, aux)
+        if status != DONE:
+            return status
+    else:
+        status = _compiled_accelerations(t, Y, g, V, parts, aux, ints)
+        if status != DONE:
+            return status
+    # dY = [dexp⁻¹(ξ) V, V̇, ẋ, ẍ, ż]
+    if nr:
+        if any_xi:
+            xd = np.empty((nr, 6))
+            _dexp_inv_apply_into(xi, V, xd)
+            for k in range(nr):
+                for i in range(6):
+                    dY[6 * k + i] = xd[k, i]
+        else:
+            for i in range(6 * nr):
+                dY[i] = Y[6 * nr + i]
+        for k in range(nr):
+            for i in range(6):
+                dY[6 * nr + 6 * k + i] = total[r_off[k] + i]
+    for i in range(ne):
+        dY[x0 + i] = Y[x0 + ne + i]
+        dY[x0 + ne + i] = total[e_off[i]]
+    for i in range(nc):
+        dY[x0 + 2 * ne + i] = z_dot[i]
+    for i in range(dY.shape[0]):
+        if not math.isfinite(dY[i]):
+            return NONFINITE
+    return DONE
+
+
+@njit(cache=True)
+def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-untyped-def]
+    """The accelerations of a FREE, FUSED or DENSE program into ``aux`` (see :func:`rhs`):
+    compiled force terms, then the parts in Python, the solve, the controllers and the loads
+    on the plant. A state whose rows the compiled QR solve cannot certify is solved in Python
+    (PHASE_ACCELERATIONS), as :meth:`System.accelerations` solves it."""
+    d = parts.dims
+    terms, params, fdata = parts.terms, parts.params, parts.field_data
+    J, Jinv, m_r, m_e = parts.J, parts.Jinv, parts.m_rigid, parts.m_euclid
+    r_off, e_off, io = parts.rigid_offsets, parts.euclid_offsets, parts.io
+    nr, ne, ndof, s, nc = d.n_rigid, d.n_euclid, d.n_dof, d.n_rows, d.n_control
+    total = aux[:ndof]
+    unmodeled = aux[ndof : 2 * ndof]
     modeled = np.zeros(ndof)
     for i in range(ndof):
         unmodeled[i] = 0.0
@@ -552,40 +856,38 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
                 code, rig != 0, t, gp, vp, m_e[idx], no_inertia, params[p0:], fdata[f0:f1], w
             )
             dof = 3
-        if status != 0:
-            return -100 - status
+        if status != 0:  # the failing state to io, where Python describes the failure
+            ints[I_FIELD] = status
+            _write_state(t, g, V, Y, d, io)
+            return FIELD
         if terms[f, 4]:
             for i in range(dof):
                 modeled[off + i] += w[i]
         else:
             for i in range(dof):
                 unmodeled[off + i] += w[i]
-    if dims[5] != 0:  # the parts without a compiled form, in Python (PythonParts)
-        io[0] = t
-        for k in range(nr):
-            for a in range(4):
-                for e in range(4):
-                    io[1 + 16 * k + 4 * a + e] = g[k, a, e]
-            for i in range(6):
-                io[1 + 16 * nr + 6 * k + i] = V[k, i]
-        for i in range(2 * ne + nc):  # x, ẋ, z
-            io[1 + 22 * nr + i] = Y[x0 + i]
-        if _call_back(dims[5], 0) != 0:
+    written = False
+    if d.python_parts:  # the parts without a compiled form, in Python (PythonParts)
+        _write_state(t, g, V, Y, d, io)
+        written = True
+        if _call_back(d.callback, PHASE_LOADS) != 0:
             return CALLBACK
-        lo = dims[9]
+        lo = d.loads_at
         for i in range(ndof):
             modeled[i] += io[lo + i]
             unmodeled[i] += io[lo + ndof + i]
-    fused = dims[8] == FUSED
-    if s and fused:
+    rank_at = 5 * ndof + s + 1 + nc
+    if s and d.solve == FUSED:
         # rigid bodies only, every load seen by the solve: the rows, then one compiled call
         A = np.zeros((s, ndof))
         b = np.empty(s)
-        _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b)
+        _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
         out = np.empty(4 * ndof + s + 3)
-        uk_rigid(V, modeled, A, b, P, out)
-        if out[4 * ndof + s + 2] != 0.0:
-            return UK_FAILED
+        uk_rigid(V, modeled, A, b, parts.uk_params, out)
+        if out[4 * ndof + s + 2] != 0.0:  # not certified: the Python solve decides
+            if not written:
+                _write_state(t, g, V, Y, d, io)
+            return _python_accelerations(parts, aux)
         for i in range(ndof):
             total[i] = out[2 * ndof + i]
             aux[2 * ndof + i] = out[ndof + i]
@@ -593,6 +895,7 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
         for i in range(s):
             aux[4 * ndof + i] = out[4 * ndof + i]
         aux[4 * ndof + s] = out[4 * ndof + s]
+        aux[rank_at] = s
     else:
         # ν̇_a = M⁻¹(ad*_V 𝕀V + Q): Eq. 10b for rigid bodies, Q/m for point masses
         if nr:
@@ -608,35 +911,41 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
             total[e_off[i]] = modeled[e_off[i]] / m_e[i]
         for i in range(2 * ndof, 4 * ndof + s + 1):
             aux[i] = 0.0
-        if s:  # the dense strategy's QR solve (DenseSolver.solve_rows), certified or handed over
+        aux[rank_at] = d.free_rank
+        if s:  # the dense strategy's certified QR solve (DenseSolver.solve_rows)
             A = np.zeros((s, ndof))
             b = np.empty(s)
-            _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b)
+            _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
             ac = aux[2 * ndof : 3 * ndof]
+            P = parts.uk_params
             Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
             residual, scale, status = _qr_solve(
                 A, b, total, Minv_sqrt, P[0], ac, aux[4 * ndof : 4 * ndof + s]
             )
-            if status != 0 or residual > P[1] * scale:
-                return UK_FAILED
+            if status != 0 or residual > P[1] * scale:  # the Python solve decides
+                if not written:
+                    _write_state(t, g, V, Y, d, io)
+                return _python_accelerations(parts, aux)
             aux[4 * ndof + s] = residual
+            aux[rank_at] = s
             _apply_M(ac, J, m_r, m_e, r_off, e_off, aux[3 * ndof : 4 * ndof])
             for i in range(ndof):
                 total[i] += ac[i]
     control = aux[4 * ndof + s + 1 : 5 * ndof + s + 1]
-    z_dot = aux[5 * ndof + s + 1 :]
+    z_dot = aux[5 * ndof + s + 1 : 5 * ndof + s + 1 + nc]
     for i in range(ndof):
         control[i] = 0.0
-    ca = dims[7]
-    if ca:  # the controllers, in Python, given the modeled acceleration ν̇_a + ν̇_c
+    ca = d.controls_at
+    if ca:  # the controllers in Python, given the modeled acceleration ν̇_a + ν̇_c
         for i in range(ndof):
             io[ca + i] = total[i]
-        if _call_back(dims[5], 1) != 0:
+        if _call_back(d.callback, PHASE_CONTROLS) != 0:
             return CALLBACK
         for i in range(ndof):
             control[i] = io[ca + ndof + i]
         for i in range(nc):
             z_dot[i] = io[ca + 2 * ndof + i]
+    ctrls, ctrl_params = parts.ctrls, parts.ctrl_params
     if ctrls.shape[0]:  # the compiled controllers (gmuk.control._kernels)
         u = np.empty(6)
         zd = np.empty(6)
@@ -650,7 +959,7 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
             for i in range(6):
                 control[o + i] += u[i]
                 z_dot[z0 + i] = zd[i]
-    if plant:  # unmodeled loads and controls act on the plant: + M⁻¹ (Q_u + u)
+    if d.plant_only:  # unmodeled loads and controls act on the plant: + M⁻¹ (Q_u + u)
         for k in range(nr):
             o = r_off[k]
             for i in range(3):
@@ -663,29 +972,7 @@ def rhs(t, Y, G0, parts, dY, aux):  # type: ignore[no-untyped-def]
         for i in range(ne):
             o = e_off[i]
             total[o] += (unmodeled[o] + control[o]) / m_e[i]
-    # dY = [dexp⁻¹(ξ) V, V̇, ẋ, ẍ]
-    if nr:
-        if any_xi:
-            xd = np.empty((nr, 6))
-            _dexp_inv_apply_into(xi, V, xd)
-            for k in range(nr):
-                for i in range(6):
-                    dY[6 * k + i] = xd[k, i]
-        else:
-            for i in range(6 * nr):
-                dY[i] = Y[6 * nr + i]
-        for k in range(nr):
-            for i in range(6):
-                dY[6 * nr + 6 * k + i] = total[r_off[k] + i]
-    for i in range(ne):
-        dY[x0 + i] = Y[x0 + ne + i]
-        dY[x0 + ne + i] = total[e_off[i]]
-    for i in range(nc):
-        dY[x0 + 2 * ne + i] = z_dot[i]
-    for i in range(dY.shape[0]):
-        if not math.isfinite(dY[i]):
-            return NONFINITE
-    return 0
+    return DONE
 
 
 @njit(cache=True)
@@ -775,7 +1062,9 @@ def _baumgarte_tracking(g, V, gd, Vd, alpha, beta, b):  # type: ignore[no-untype
     e_V = V − Ad_{(g_d⁻¹ g)⁻¹} V_d (gmuk.constraints.tracking.tracking_errors)."""
     gd_inv = np.zeros((1, 4, 4))
     gd1 = np.empty((1, 4, 4))
-    gd1[0] = gd
+    for a in range(4):
+        for e in range(4):
+            gd1[0, a, e] = gd[a, e]
     _se3_inverse_into(gd1, gd_inv)
     g_err = np.zeros((1, 4, 4))
     for a in range(4):
@@ -832,44 +1121,6 @@ def _rms(v, sc):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def initial_step(t, Y, G0, f0, t_end, first_step, max_step, order, parts, fs, ints):  # type: ignore[no-untyped-def]
-    """:meth:`gmuk.integrate._Stepper._initial_step` (Hairer's starting step). Returns the
-    step, or a negative number on a failed evaluation (status in ints[I_FIELD])."""
-    if first_step > 0.0:
-        return min(first_step, t_end - t)
-    nr, ndof = parts[9][0], parts[9][2]
-    n = Y.shape[0]
-    sc = np.empty(n)
-    _scale(Y, Y, G0, nr, parts[16], fs[F_RTOL], fs[F_ATOL], sc)
-    d0 = _rms(Y, sc)
-    d1 = _rms(f0, sc)
-    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
-    h0 = min(h0, t_end - t)
-    f1 = np.empty(n)
-    aux = np.empty(5 * ndof + parts[9][4] + 1 + parts[9][6])
-    ints[I_RHS] += 1
-    status = rhs(t + h0, Y + h0 * f0, G0, parts, f1, aux)
-    if status != 0:
-        ints[I_FIELD] = status
-        fs[F_BAD_T] = t + h0
-        return -1.0
-    acc = 0.0
-    for i in range(n):
-        acc += ((f1[i] - f0[i]) / sc[i]) ** 2
-    d2 = math.sqrt(acc / n) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
-    return min(100 * h0, h1, max_step, t_end - t)
-
-
-@njit(cache=True)
-def _factor(err, order):  # type: ignore[no-untyped-def]
-    return 0.9 * (max(err, 1e-10) ** (-1.0 / order))
-
-
-@njit(cache=True)
 def _interpolate(F, Y0, s, out):  # type: ignore[no-untyped-def]
     """DOP853's continuous extension u(s) into ``out`` (gmuk.integrators.dop853)."""
     n = Y0.shape[0]
@@ -894,49 +1145,288 @@ def _stage_state(Y, h, a, K, i, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux):  # type: ignore[no-untyped-def]
-    """Run steps from (fs[F_T], Y, G0) with f0 = f(t, Y) and the outputs ``aux`` of that
-    evaluation (see :func:`rhs`), until the end time, ``ints[I_CHUNK]`` steps, full output
-    buffers or a failure; returns the status (module constants). Y, G0, f0, aux, fs and
-    ints are updated in place to the last accepted step; outputs are appended to the buffers
-    (times bt, states bY, base poses bG, rhs outputs baux) from ints[I_WRITTEN]."""
-    A, b, c, E, E3, Ax, Cx, D, mi = meth
-    s, n_rows, fsal, adaptive, order, dop853, dense = (
-        mi[0],
-        mi[1],
-        mi[2],
-        mi[3],
-        mi[4],
-        mi[5],
-        mi[6],
-    )
-    dims = parts[9]
-    nr, ne = dims[0], dims[1]
+def _factor(err, m):  # type: ignore[no-untyped-def]
+    """The step-size factor for a scaled error estimate (1: at tolerance): the classical
+    ``safety · err^(−1/order)``, err floored so that a zero estimate grows the step by the
+    largest factor."""
+    return m.safety * (max(err, m.error_floor) ** (-1.0 / m.order))
+
+
+@njit(cache=True)
+def _grown(h, err, m):  # type: ignore[no-untyped-def]
+    """The next step after an accepted one of size h."""
+    return h * min(m.max_factor, max(m.min_factor, _factor(err, m)))
+
+
+@njit(cache=True)
+def _shrunk(h, err, m):  # type: ignore[no-untyped-def]
+    """The retry after a rejected step of size h."""
+    return h * max(m.min_factor, min(m.max_factor_rejected, _factor(err, m)))
+
+
+@njit(cache=True)
+def _fail(status, t, fs, ints):  # type: ignore[no-untyped-def]
+    """Record a failed evaluation at time t; returns the status to report."""
+    fs[F_BAD_T] = t
+    return status
+
+
+@njit(cache=True)
+def _initial_step(t, Y, G0, f0, parts, m, fs, ints):  # type: ignore[no-untyped-def]
+    """Hairer's starting step (Hairer, Nørsett & Wanner, Solving ODEs I, §II.4), or the
+    user's first step. Returns the step, or −(status) after a failed evaluation."""
+    t_end = fs[F_END]
+    if fs[F_FIRST_STEP] > 0.0:
+        return min(fs[F_FIRST_STEP], t_end - t)
+    d = parts.dims
+    n = Y.shape[0]
+    sc = np.empty(n)
+    _scale(Y, Y, G0, d.n_rigid, parts.point_starts, fs[F_RTOL], fs[F_ATOL], sc)
+    d0 = _rms(Y, sc)
+    d1 = _rms(f0, sc)
+    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+    h0 = min(h0, t_end - t)
+    Yt = np.empty(n)
+    for i in range(n):
+        Yt[i] = Y[i] + h0 * f0[i]
+    f1 = np.empty(n)
+    aux = np.empty(aux_size_of(d))
+    ints[I_RHS] += 1
+    status = rhs(t + h0, Yt, G0, parts, f1, aux, ints)
+    if status != DONE:
+        _fail(status, t + h0, fs, ints)
+        return float(status)
+    acc = 0.0
+    for i in range(n):
+        acc += ((f1[i] - f0[i]) / sc[i]) ** 2
+    d2 = math.sqrt(acc / n) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (m.order + 1))
+    return min(100 * h0, h1, fs[F_MAX_STEP], t_end - t)
+
+
+@njit(cache=True)
+def aux_size_of(d):  # type: ignore[no-untyped-def]
+    """:func:`aux_size` of a program's dims."""
+    return 5 * d.n_dof + d.n_rows + 2 + d.n_control
+
+
+@njit(cache=True)
+def _record(t, Y, G0, aux, ints, bt, bY, bG, baux):  # type: ignore[no-untyped-def]
+    """Append one output row (t, Y, G0, aux) to the buffers."""
+    w = ints[I_WRITTEN]
+    bt[w] = t
+    for j in range(Y.shape[0]):
+        bY[w, j] = Y[j]
+    for k in range(G0.shape[0]):
+        for a in range(4):
+            for e in range(4):
+                bG[w, k, a, e] = G0[k, a, e]
+    for i in range(aux.shape[0]):
+        baux[w, i] = aux[i]
+    ints[I_WRITTEN] = w + 1
+
+
+@njit(cache=True)
+def _start(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux):  # type: ignore[no-untyped-def]
+    """The first evaluation at the start time: f0 and aux, the output at the start time of
+    a fresh run, and the starting step when none is set. Returns the status."""
+    t = fs[F_T]
+    ints[I_RHS] += 1
+    status = rhs(t, Y, G0, parts, f0, aux, ints)
+    if status != DONE:
+        return _fail(status, t, fs, ints)
+    ints[I_STARTED] = 1
+    if ints[I_FRESH]:
+        if (not has_outs) or outs[0] == t:
+            _record(t, Y, G0, aux, ints, bt, bY, bG, baux)
+            if has_outs:
+                ints[I_OUT] = 1
+        if m.adaptive and fs[F_H] <= 0.0:
+            h = _initial_step(t, Y, G0, f0, parts, m, fs, ints)
+            if h <= 0.0:
+                return int(h)
+            fs[F_H] = h
+    return DONE
+
+
+@njit(cache=True)
+def _step_error(K, Y, Y1, G0, h, parts, m, fs, sc):  # type: ignore[no-untyped-def]
+    """The scaled error of a step (≤ 1: within tolerance), its weights into ``sc``."""
+    n = Y.shape[0]
+    _scale(Y, Y1, G0, parts.dims.n_rigid, parts.point_starts, fs[F_RTOL], fs[F_ATOL], sc)
+    if m.dop853:  # Hairer's combination of the order-5 and order-3 estimates
+        n5 = 0.0
+        n3 = 0.0
+        for j in range(n):
+            e5 = 0.0
+            e3 = 0.0
+            for i in range(m.n_rows):
+                e5 += K[i, j] * m.E[i]
+                e3 += K[i, j] * m.E3[i]
+            n5 += (e5 / sc[j]) ** 2
+            n3 += (e3 / sc[j]) ** 2
+        if n5 == 0.0 and n3 == 0.0:
+            return 0.0
+        return abs(h) * n5 / math.sqrt((n5 + m.e3_weight * n3) * n)
+    acc2 = 0.0
+    for j in range(n):
+        e = 0.0
+        for i in range(m.n_rows):
+            e += K[i, j] * m.E[i]
+        acc2 += (h * e / sc[j]) ** 2
+    return math.sqrt(acc2 / n)
+
+
+@njit(cache=True)
+def _extension(t, h, Y, Y1, K, G0, parts, m, fs, ints, F):  # type: ignore[no-untyped-def]
+    """DOP853's continuous extension on [t, t + h] into F (three more stages). Returns the
+    status."""
+    n = Y.shape[0]
+    n_ext = m.A_ext.shape[0]
+    Kx = np.empty((n_ext, n))
+    Yt = np.empty(n)
+    tmp_aux = np.empty(aux_size_of(parts.dims))
+    first = m.n_stages + 1
+    for i in range(first):
+        for j in range(n):
+            Kx[i, j] = K[i, j]
+    for i in range(first, n_ext):
+        _stage_state(Y, h, m.A_ext[i], Kx, i, Yt)
+        ints[I_RHS] += 1
+        status = rhs(t + m.c_ext[i] * h, Yt, G0, parts, Kx[i], tmp_aux, ints)
+        if status != DONE:
+            return _fail(status, t + m.c_ext[i] * h, fs, ints)
+    last = m.n_stages
+    for j in range(n):
+        dy = Y1[j] - Y[j]
+        F[0, j] = dy
+        F[1, j] = h * K[0, j] - dy
+        F[2, j] = 2.0 * dy - h * (K[last, j] + K[0, j])
+    for r in range(m.D.shape[0]):
+        for j in range(n):
+            q = 0.0
+            for k in range(n_ext):
+                q += m.D[r, k] * Kx[k, j]
+            F[3 + r, j] = h * q
+    return DONE
+
+
+@njit(cache=True)
+def _extension_error(t, h, Y, F, G0, parts, m, fs, ints, sc):  # type: ignore[no-untyped-def]
+    """The continuous extension's error from its defect at s* (DOP853.interpolant_error):
+    returns (scaled error, status)."""
+    n = Y.shape[0]
+    s_star = m.defect_node
+    p = F.shape[0]
+    u = np.zeros(n)
+    du = np.zeros(n)
+    for i in range(p):
+        for j in range(n):
+            qq = u[j] + F[p - 1 - i, j]
+            if i % 2 == 0:
+                u[j], du[j] = qq * s_star, du[j] * s_star + qq
+            else:
+                u[j], du[j] = qq * (1.0 - s_star), du[j] * (1.0 - s_star) - qq
+    for j in range(n):
+        u[j] += Y[j]
+    ddy = np.empty(n)
+    tmp_aux = np.empty(aux_size_of(parts.dims))
+    ints[I_RHS] += 1
+    status = rhs(t + s_star * h, u, G0, parts, ddy, tmp_aux, ints)
+    if status != DONE:
+        return 0.0, _fail(status, t + s_star * h, fs, ints)
+    acc2 = 0.0
+    for j in range(n):
+        acc2 += ((h * ddy[j] - du[j]) / sc[j]) ** 2
+    return m.defect_gain * math.sqrt(acc2 / n), DONE
+
+
+@njit(cache=True)
+def _new_base(Y1, G0, nr):  # type: ignore[no-untyped-def]
+    """G₀ ← G₀ exp(ξ₁), re-orthonormalised by one Newton–Schulz step R ← R(3I − RᵀR)/2, and
+    ξ₁ ← 0 (in place)."""
+    if nr == 0:
+        return
+    xi1 = np.empty((nr, 6))
+    for k in range(nr):
+        for i in range(6):
+            xi1[k, i] = Y1[6 * k + i]
+    G1 = np.empty((nr, 4, 4))
+    _compose_exp_into(G0, xi1, G1)
+    R = np.empty((3, 3))
+    RtR = np.empty((3, 3))
+    for k in range(nr):
+        for i in range(3):
+            for j in range(3):
+                R[i, j] = G1[k, i, j]
+        for i in range(3):
+            for j in range(3):
+                RtR[i, j] = R[0, i] * R[0, j] + R[1, i] * R[1, j] + R[2, i] * R[2, j]
+        for i in range(3):
+            for j in range(3):
+                q = 0.0
+                for a in range(3):
+                    q += R[i, a] * ((3.0 if a == j else 0.0) - RtR[a, j])
+                G1[k, i, j] = 0.5 * q
+    for i in range(6 * nr):
+        Y1[i] = 0.0
+    for k in range(nr):
+        for a in range(4):
+            for e in range(4):
+                G0[k, a, e] = G1[k, a, e]
+
+
+@njit(cache=True)
+def _first_stage(Y, aux, parts, f0):  # type: ignore[no-untyped-def]
+    """The next step's first stage at the new base: ξ̇ = V at ξ = 0, and the accelerations
+    of the step end's evaluation (aux)."""
+    d = parts.dims
+    nr, ne = d.n_rigid, d.n_euclid
+    for i in range(6 * nr):
+        f0[i] = Y[6 * nr + i]
+    for k in range(nr):
+        for i in range(6):
+            f0[6 * nr + 6 * k + i] = aux[parts.rigid_offsets[k] + i]
+    x0 = 12 * nr
+    for i in range(ne):
+        f0[x0 + i] = Y[x0 + ne + i]
+        f0[x0 + ne + i] = aux[parts.euclid_offsets[i]]
+    z_at = 5 * d.n_dof + d.n_rows + 1  # ż in the outputs of rhs
+    for i in range(d.n_control):
+        f0[x0 + 2 * ne + i] = aux[z_at + i]
+
+
+@njit(cache=True)
+def advance(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux):  # type: ignore[no-untyped-def]
+    """Run steps from (fs[F_T], Y, G0) until the end time, ``ints[I_CHUNK]`` steps, full
+    output buffers or a failure; returns the :class:`Status`.
+
+    The first call (``ints[I_STARTED]`` 0) evaluates f0 and aux at the start and, for a fresh
+    run, records the output at the start time and takes the starting step. Y, G0, f0 (f at
+    the last accepted step), aux (its other outputs), fs and ints are updated in place to
+    the last accepted step; outputs are appended to the buffers (times bt, states bY, base
+    poses bG, rhs outputs baux) from ints[I_WRITTEN]."""
+    if ints[I_STARTED] == 0:
+        status = _start(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux)
+        if status != DONE:
+            return status
+    nr = parts.dims.n_rigid
     n = Y.shape[0]
     t, h, t_end = fs[F_T], fs[F_H], fs[F_END]
-    rtol, atol, max_step = fs[F_RTOL], fs[F_ATOL], fs[F_MAX_STEP]
     out_i = ints[I_OUT]
     n_outs = outs.shape[0]
-    cap = bt.shape[0]
-    step_to_outputs = (not dense) and has_outs
-    use_dense = dense and has_outs
+    use_dense = m.dense and has_outs
+    step_to_outputs = (not m.dense) and has_outs
     eps = np.finfo(np.float64).eps
-    K = np.empty((n_rows, n))
-    Kx = np.empty((_tab.N_STAGES_EXTENDED, n))
+    K = np.empty((m.n_rows, n))
     F = np.empty((_tab.INTERPOLATOR_POWER, n))
     Yt = np.empty(n)
     Y1 = np.empty(n)
-    f1 = np.empty(n)
     sc = np.empty(n)
-    n_aux = aux.shape[0]
-    aux1 = np.empty(n_aux)
-    tmp_aux = np.empty(n_aux)
-    G1 = np.empty((nr, 4, 4))
-    R = np.empty((3, 3))
-    RtR = np.empty((3, 3))
-    u = np.empty(n)
-    du = np.empty(n)
-    ddy = np.empty(n)
+    aux1 = np.empty(aux.shape[0])
     steps_here = 0
     status = DONE
     while t < t_end:
@@ -946,219 +1436,86 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
         if steps_here >= ints[I_CHUNK]:
             status = PAUSE
             break
-        h = min(h, max_step)
-        t_target = t_end
-        if step_to_outputs and out_i < n_outs:
-            t_target = min(t_end, outs[out_i])
+        h = min(h, fs[F_MAX_STEP])
+        t_target = min(t_end, outs[out_i]) if step_to_outputs and out_i < n_outs else t_end
+        # land exactly on the target when within a hair of it (no sliver steps)
         landing = t_target - t <= h * (1.0 + 1e-6)
         h_try = t_target - t if landing else h
         if h_try <= 10 * eps * max(1.0, abs(t)):
             status = UNDERFLOW
             fs[F_H] = h_try
             break
-        # room for this step's outputs
-        need = 1
-        if use_dense:
-            j = out_i
-            while j < n_outs and outs[j] <= t + h_try:
-                need += 1
-                j += 1
-        if ints[I_WRITTEN] + need > cap:
+        need = 1  # room for this step's outputs
+        j = out_i
+        while use_dense and j < n_outs and outs[j] <= t + h_try:
+            need += 1
+            j += 1
+        if ints[I_WRITTEN] + need > bt.shape[0]:
             ints[I_NEED] = need
             status = FULL
             break
-        # stages
         for j in range(n):
             K[0, j] = f0[j]
-        bad = 0
-        for i in range(1, s):
-            _stage_state(Y, h_try, A[i], K, i, Yt)
+        for i in range(1, m.n_stages):
+            _stage_state(Y, h_try, m.A[i], K, i, Yt)
             ints[I_RHS] += 1
-            bad = rhs(t + c[i] * h_try, Yt, G0, parts, K[i], tmp_aux)
-            if bad != 0:
-                fs[F_BAD_T] = t + c[i] * h_try
+            status = rhs(t + m.c[i] * h_try, Yt, G0, parts, K[i], aux1, ints)
+            if status != DONE:
+                status = _fail(status, t + m.c[i] * h_try, fs, ints)
                 break
-        if bad != 0:
-            status = bad if bad > -100 else FIELD
-            ints[I_FIELD] = bad
+        if status != DONE:
             break
-        for j in range(n):
-            q = 0.0
-            for i in range(s):
-                q += b[i] * K[i, j]
-            Y1[j] = Y[j] + h_try * q
+        _stage_state(Y, h_try, m.b, K, m.n_stages, Y1)
         ints[I_RHS] += 1
-        bad = rhs(t + h_try, Y1, G0, parts, f1, aux1)
-        if bad != 0:
-            fs[F_BAD_T] = t + h_try
-            status = bad if bad > -100 else FIELD
-            ints[I_FIELD] = bad
+        status = rhs(t + h_try, Y1, G0, parts, Yt, aux1, ints)  # Yt: f(t + h, y₁)
+        if status != DONE:
+            status = _fail(status, t + h_try, fs, ints)
             break
-        if fsal:
+        if m.fsal:
             for j in range(n):
-                K[n_rows - 1, j] = f1[j]
+                K[m.n_rows - 1, j] = Yt[j]
         h_next = h
-        if adaptive:
-            _scale(Y, Y1, G0, nr, parts[16], rtol, atol, sc)
-            if dop853:
-                n5 = 0.0
-                n3 = 0.0
-                for j in range(n):
-                    e5 = 0.0
-                    e3 = 0.0
-                    for i in range(n_rows):
-                        e5 += K[i, j] * E[i]
-                        e3 += K[i, j] * E3[i]
-                    n5 += (e5 / sc[j]) ** 2
-                    n3 += (e3 / sc[j]) ** 2
-                err = 0.0
-                if n5 != 0.0 or n3 != 0.0:
-                    err = abs(h_try) * n5 / math.sqrt((n5 + 0.01 * n3) * n)
-            else:
-                acc2 = 0.0
-                for j in range(n):
-                    e = 0.0
-                    for i in range(n_rows):
-                        e += K[i, j] * E[i]
-                    acc2 += (h_try * e / sc[j]) ** 2
-                err = math.sqrt(acc2 / n)
-            factor = _factor(err, order)
+        if m.adaptive:
+            err = _step_error(K, Y, Y1, G0, h_try, parts, m, fs, sc)
             if err > 1.0:
                 ints[I_REJECTED] += 1
-                h = h_try * max(0.2, min(0.9, factor))
+                h = _shrunk(h_try, err, m)
                 continue
-            h_next = h_try * min(10.0, max(0.2, factor))
+            h_next = _grown(h_try, err, m)
         t_new = t_target if landing else t + h_try
         if use_dense and out_i < n_outs and outs[out_i] < t_new:
-            # DOP853's continuous extension: three more stages
-            ne_rows = _tab.N_STAGES + 1
-            for i in range(ne_rows):
-                for j in range(n):
-                    Kx[i, j] = K[i, j]
-            for i in range(ne_rows, _tab.N_STAGES_EXTENDED):
-                _stage_state(Y, h_try, Ax[i], Kx, i, Yt)
-                ints[I_RHS] += 1
-                bad = rhs(t + Cx[i] * h_try, Yt, G0, parts, Kx[i], tmp_aux)
-                if bad != 0:
-                    fs[F_BAD_T] = t + Cx[i] * h_try
-                    break
-            if bad != 0:
-                status = bad if bad > -100 else FIELD
-                ints[I_FIELD] = bad
+            status = _extension(t, h_try, Y, Y1, K, G0, parts, m, fs, ints, F)
+            if status != DONE:
                 break
-            last = _tab.N_STAGES
-            for j in range(n):
-                dy = Y1[j] - Y[j]
-                F[0, j] = dy
-                F[1, j] = h_try * K[0, j] - dy
-                F[2, j] = 2.0 * dy - h_try * (K[last, j] + K[0, j])
-            for r in range(D.shape[0]):
-                for j in range(n):
-                    q = 0.0
-                    for m in range(_tab.N_STAGES_EXTENDED):
-                        q += D[r, m] * Kx[m, j]
-                    F[3 + r, j] = h_try * q
-            if adaptive:
-                # the extension's error from its defect at s* = 0.95 (DOP853.interpolant_error)
-                s_star = 0.95
-                p = F.shape[0]
-                for j in range(n):
-                    u[j] = 0.0
-                    du[j] = 0.0
-                for i in range(p):
-                    for j in range(n):
-                        qq = u[j] + F[p - 1 - i, j]
-                        if i % 2 == 0:
-                            u[j], du[j] = qq * s_star, du[j] * s_star + qq
-                        else:
-                            u[j], du[j] = qq * (1.0 - s_star), du[j] * (1.0 - s_star) - qq
-                for j in range(n):
-                    u[j] += Y[j]
-                ints[I_RHS] += 1
-                bad = rhs(t + s_star * h_try, u, G0, parts, ddy, tmp_aux)
-                if bad != 0:
-                    fs[F_BAD_T] = t + s_star * h_try
-                    status = bad if bad > -100 else FIELD
-                    ints[I_FIELD] = bad
+            if m.adaptive:  # the extension must meet the tolerance too, or a shorter retry
+                err_d, status = _extension_error(t, h_try, Y, F, G0, parts, m, fs, ints, sc)
+                if status != DONE:
                     break
-                acc2 = 0.0
-                for j in range(n):
-                    acc2 += ((h_try * ddy[j] - du[j]) / sc[j]) ** 2
-                err_d = 0.18 * math.sqrt(acc2 / n)
-                factor_d = _factor(err_d, order)
                 if err_d > 1.0:
                     ints[I_REJECTED] += 1
-                    h = h_try * max(0.2, min(0.9, factor_d))
+                    h = _shrunk(h_try, err_d, m)
                     continue
-                h_next = min(h_next, h_try * min(10.0, max(0.2, factor_d)))
+                h_next = min(h_next, _grown(h_try, err_d, m))
             while out_i < n_outs and outs[out_i] < t_new:
                 tt = outs[out_i]
                 w = ints[I_WRITTEN]
                 _interpolate(F, Y, (tt - t) / h_try, bY[w])
-                bad = rhs(tt, bY[w], G0, parts, ddy, baux[w])
-                if bad != 0:
-                    fs[F_BAD_T] = tt
+                status = rhs(tt, bY[w], G0, parts, Yt, baux[w], ints)
+                if status != DONE:
+                    status = _fail(status, tt, fs, ints)
                     break
-                bt[w] = tt
-                for k in range(nr):
-                    bG[w, k] = G0[k]
-                ints[I_WRITTEN] = w + 1
+                _record(tt, bY[w], G0, baux[w], ints, bt, bY, bG, baux)
                 out_i += 1
-            if bad != 0:
-                status = bad if bad > -100 else FIELD
-                ints[I_FIELD] = bad
+            if status != DONE:
                 break
-        # the new base G₁ = G₀ exp(ξ₁), re-orthonormalised: R ← R(3I − RᵀR)/2
-        if nr:
-            xi1 = np.empty((nr, 6))
-            for k in range(nr):
-                for i in range(6):
-                    xi1[k, i] = Y1[6 * k + i]
-            _compose_exp_into(G0, xi1, G1)
-            for k in range(nr):
-                for i in range(3):
-                    for j in range(3):
-                        R[i, j] = G1[k, i, j]
-                for i in range(3):
-                    for j in range(3):
-                        RtR[i, j] = R[0, i] * R[0, j] + R[1, i] * R[1, j] + R[2, i] * R[2, j]
-                for i in range(3):
-                    for j in range(3):
-                        q = 0.0
-                        for m in range(3):
-                            q += R[i, m] * ((3.0 if m == j else 0.0) - RtR[m, j])
-                        G1[k, i, j] = 0.5 * q
-            for i in range(6 * nr):
-                Y1[i] = 0.0
-            for k in range(nr):
-                G0[k] = G1[k]
-        # the next step's first stage: ξ̇ = V at ξ = 0, and the same accelerations
+        _new_base(Y1, G0, nr)
         for j in range(n):
             Y[j] = Y1[j]
-        for i in range(6 * nr):
-            f0[i] = Y[6 * nr + i]
-        for k in range(nr):
-            for i in range(6):
-                f0[6 * nr + 6 * k + i] = aux1[parts[7][k] + i]
-        x0 = 12 * nr
-        for i in range(ne):
-            f0[x0 + i] = Y[x0 + ne + i]
-            f0[x0 + ne + i] = aux1[parts[8][i]]
-        z_at = 5 * dims[2] + dims[4] + 1  # ż in the outputs of rhs
-        for i in range(dims[6]):
-            f0[x0 + 2 * ne + i] = aux1[z_at + i]
-        for i in range(n_aux):
+        _first_stage(Y, aux1, parts, f0)
+        for i in range(aux.shape[0]):
             aux[i] = aux1[i]
         if (not has_outs) or (out_i < n_outs and outs[out_i] == t_new):
-            w = ints[I_WRITTEN]
-            bt[w] = t_new
-            for j in range(n):
-                bY[w, j] = Y[j]
-            for k in range(nr):
-                bG[w, k] = G0[k]
-            for i in range(n_aux):
-                baux[w, i] = aux1[i]
-            ints[I_WRITTEN] = w + 1
+            _record(t_new, Y, G0, aux, ints, bt, bY, bG, baux)
             if has_outs:
                 out_i += 1
         t, h = t_new, h_next
@@ -1175,51 +1532,40 @@ def advance(parts, meth, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, b
 
 
 # --------------------------------------------------------------- compiling, once per machine
-#: Set to "0" to keep ``simulate`` from compiling the loop in a background process.
-BACKGROUND_ENV = "GMUK_BACKGROUND_COMPILE"
-#: A background compilation's lock older than this (s) is taken for a dead one's.
-LOCK_STALE_S = 900.0
-_ENTRIES = ("rhs", "initial_step", "advance")
-_spawned = False
+#: What a cold compilation of the loop takes on a 2-core machine (s), as announced.
+EXPECTED_COMPILE_S = "30-60 s"
 _ready = False  # the loop is compiled or loaded in this process (every program's types)
-#: What ``simulate(compiled=None)`` does when the loop is not compiled yet: False (default)
-#: take the Python loop and compile aside; True compile it first (campaign workers, whose
-#: runs must not depend on when the compilation ends).
-compile_on_first_use = False
 
 
-def signatures(prog: Program) -> tuple[tuple[Any, ...], ...]:
-    """The numba argument types of :func:`rhs`, :func:`initial_step` and :func:`advance` as
-    the driver (gmuk.integrate._CompiledStepper) calls them for ``prog``."""
+def signature(prog: Program | None = None) -> tuple[Any, ...]:
+    """The numba argument types of :func:`advance` as the driver calls it (every program has
+    the same types; :func:`reference_program` stands for all of them)."""
     from numba import typeof
 
-    f, v = typeof(0.0), typeof(np.empty(1))
+    prog = prog if prog is not None else reference_program()
+    v = typeof(np.empty(1))
     i = typeof(np.empty(1, dtype=np.int64))
     G = typeof(np.empty((1, 4, 4)))
-    parts, meth = typeof(prog.parts), typeof(prog.method)
     return (
-        (f, v, G, parts, v, v),
-        (f, v, G, v, f, f, f, typeof(1), parts, v, i),
-        (parts, meth, v, i, v, G, v, v, v, typeof(True), v, typeof(np.empty((1, 1))),
-         typeof(np.empty((1, 1, 4, 4))), typeof(np.empty((1, 1)))),
+        typeof(prog.parts), typeof(prog.method), v, i, v, G, v, v, v, typeof(True), v,
+        typeof(np.empty((1, 1))), typeof(np.empty((1, 1, 4, 4))), typeof(np.empty((1, 1))),
     )  # fmt: skip
 
 
-def _reference_program() -> Program:
+def reference_program() -> Program:
     """The program of a one point mass System: its argument types are every program's."""
     from gmuk.bodies import PointMass
     from gmuk.forces.gravity import PointMassGravity
     from gmuk.system import System
 
     system = System([PointMass("p", 1.0)], [], [PointMassGravity(1.0)])
-    prog = program(system, DOP853())
-    assert isinstance(prog, Program), prog
-    return prog
+    state = system.state(r={"p": [1.0, 0.0, 0.0]}, v={"p": [0.0, 1.0, 0.0]})
+    return program(system, DOP853(), state)
 
 
 def loaded(prog: Program | None = None) -> bool:
-    """Whether the loop is compiled for ``prog``'s argument types (all programs share them)
-    in this process, loading it from numba's cache when it is there; never compiles.
+    """Whether the loop is compiled in this process, loading it from numba's cache when it is
+    there; never compiles.
 
     This reads numba's dispatcher internals (its cache and overloads, numba 0.59–0.68);
     if they change, it answers False and the loop compiles on the next ``compile_loop``."""
@@ -1228,73 +1574,62 @@ def loaded(prog: Program | None = None) -> bool:
         return True
     from numba.core.compiler_lock import global_compiler_lock
 
-    sigs = signatures(prog if prog is not None else _reference_program())
+    sig = signature(prog)
     try:
         with global_compiler_lock:
-            for name, sig in zip(_ENTRIES, sigs, strict=True):
-                disp = globals()[name]
-                if tuple(sig) in disp.overloads:
-                    continue
-                cres = disp._cache.load_overload(sig, disp.targetctx)
+            if tuple(sig) not in advance.overloads:
+                cres = advance._cache.load_overload(sig, advance.targetctx)
                 if cres is None:
                     return False
-                disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
-                disp.add_overload(cres)
+                advance.targetctx.insert_user_function(
+                    cres.entry_point, cres.fndesc, [cres.library]
+                )
+                advance.add_overload(cres)
     except (AttributeError, TypeError):  # numba's internals moved
         return False
     _ready = True
     return True
 
 
-def _lock_path() -> Path:
-    """The lock of a background compilation, one per numba cache folder of this module."""
-    cache = getattr(getattr(advance, "_cache", None), "_cache_path", "") or "no-cache"
-    key = hashlib.sha256(str(cache).encode()).hexdigest()[:16]
-    return Path(tempfile.gettempdir()) / f"gmuk-compile-{key}.lock"
-
-
-def _cacheable() -> bool:
-    return type(getattr(advance, "_cache", None)).__name__ != "NullCache"
-
-
-def compile_loop(*, background: bool = False, timeout: float = 600.0) -> bool:
+def compile_loop(*, announce: bool = True, timeout: float = 900.0) -> bool:
     """Compile the step loop once for this machine, or load it from numba's cache.
+
+    Compiling takes 30–60 s on a 2-core machine (once; later processes load the loop in a
+    fraction of a second). With ``announce`` it says so on stderr, in one line, before it
+    starts. One process compiles at a time per cache folder: the others wait on a lock (an
+    advisory lock that the operating system releases when its process ends, killed or
+    not) and then load what it compiled.
 
     Parameters
     ----------
-    background : bool
-        Start the compilation in a separate process and return at once (False: compile here
-        and return when done). Either way one process per cache folder compiles at a time
-        (a lock file in the temporary folder); the others wait for it and load its result.
+    announce : bool
+        Write one line to stderr when the loop has to be compiled (default True).
     timeout : float
-        The longest to wait (s) for a compilation another process is running; after that,
-        this one compiles too.
+        The longest to wait (s) for another process's compilation; after that this one
+        compiles too.
 
     Returns
     -------
     bool
-        Whether the loop is ready in this process.
+        True: the loop is ready in this process.
     """
     if loaded():
         return True
-    if background:
-        _spawn()
-        return False
-    lock = _lock_path()
-    deadline = time.monotonic() + timeout
-    owned = False
-    while time.monotonic() < deadline:
-        owned = _take(lock)
-        if owned:
-            break
-        time.sleep(0.5)
-        if loaded():
+    start = time.perf_counter()
+    with _compile_lock(timeout, announce) as waited:
+        if waited and loaded():  # the other process compiled it
             return True
-    try:
+        if announce:
+            print(
+                f"gmuk: compiling the integrator loop for this machine, once "
+                f"(about {EXPECTED_COMPILE_S}; `gmuk compile` does it ahead) ...",
+                end="",
+                file=sys.stderr,
+                flush=True,
+            )
         _compile_now()
-    finally:
-        if owned:
-            lock.unlink(missing_ok=True)
+        if announce:
+            print(f" done in {time.perf_counter() - start:.1f} s", file=sys.stderr, flush=True)
     return True
 
 
@@ -1303,85 +1638,59 @@ def _compile_now() -> None:
     # resolving it first loads it (or compiles it once) and keeps the loop from compiling
     # a second copy for other argument types.
     _field_kernels.ENTRIES.acceleration_at  # noqa: B018
-    for name, sig in zip(_ENTRIES, signatures(_reference_program()), strict=True):
-        globals()[name].compile(sig)
+    advance.compile(signature())
     global _ready
     _ready = True
 
 
-def _take(lock: Path) -> bool:
-    """Create ``lock`` (True), or False while another process holds a live one."""
-    if lock.exists() and not _lock_held(lock):
-        lock.unlink(missing_ok=True)  # a stale one: its process died
-    try:
-        fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-    except FileExistsError:
-        return False
-    except OSError:  # no temporary folder to write in: compile without a lock
-        return True
-    os.write(fd, str(os.getpid()).encode())
-    os.close(fd)
-    return True
+def _lock_path() -> Path:
+    """The lock file beside the loop's numba cache (the temporary folder without one)."""
+    import tempfile
+
+    cache = getattr(getattr(advance, "_cache", None), "_cache_path", "") or ""
+    folder = Path(cache) if cache else Path(tempfile.gettempdir())
+    return folder / "gmuk-compile.lock"
 
 
 @contextlib.contextmanager
-def compiling_on_first_use() -> Iterator[None]:
-    """Within: ``simulate(compiled=None)`` compiles the loop if it is not compiled yet
-    instead of taking the Python loop (:data:`compile_on_first_use`)."""
-    global compile_on_first_use
-    before, compile_on_first_use = compile_on_first_use, True
+def _compile_lock(timeout: float, announce: bool) -> Iterator[bool]:
+    """Hold the compile lock inside (yields whether another process held it first).
+
+    An advisory ``flock`` on a file beside the cache: it belongs to a live process only, so
+    a compiler that was killed blocks nobody. Without ``fcntl`` (Windows) or a writable
+    folder there is no lock, and concurrent processes may each compile."""
     try:
-        yield
-    finally:
-        compile_on_first_use = before
-
-
-def _lock_held(lock: Path) -> bool:
-    try:
-        return time.time() - lock.stat().st_mtime < LOCK_STALE_S
-    except OSError:
-        return False
-
-
-def _spawn() -> None:
-    """Compile the loop in a detached background process, at most once per process and one
-    process per cache folder at a time (a lock file), unless GMUK_BACKGROUND_COMPILE=0 or
-    numba cannot cache (each process would compile again)."""
-    global _spawned
-    if _spawned or os.environ.get(BACKGROUND_ENV, "1") == "0" or not _cacheable():
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows
+        yield False
         return
-    _spawned = True
-    lock = _lock_path()
-    if not _take(lock):
-        return  # another process is compiling
     try:
-        subprocess.Popen(
-            [sys.executable, "-m", "gmuk.integrators._compiled", str(lock)],
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-            start_new_session=True,
-            close_fds=True,
-        )
+        path = _lock_path()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o644)
     except OSError:
-        lock.unlink(missing_ok=True)
-
-
-def _main(argv: list[str]) -> int:
-    """The background compilation: compile the loop (numba caches it), then drop the lock."""
-    lock = Path(argv[0]) if argv else None
+        yield False
+        return
+    waited = False
+    deadline = time.monotonic() + timeout
     try:
-        with contextlib.suppress(OSError, AttributeError):
-            os.nice(10)  # the user's own runs first
-        if not loaded():
-            _compile_now()
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if not waited and announce:
+                    print(
+                        "gmuk: waiting for another process that compiles the integrator loop",
+                        file=sys.stderr,
+                        flush=True,
+                    )
+                waited = True
+                if time.monotonic() > deadline:
+                    break  # compile without the lock
+                time.sleep(0.2)
+        yield waited
     finally:
-        if lock is not None:
-            lock.unlink(missing_ok=True)
-    return 0
-
-
-if __name__ == "__main__":  # run as a module: compile in the imported module, not __main__
-    from gmuk.integrators import _compiled
-
-    sys.exit(_compiled._main(sys.argv[1:]))
+        with contextlib.suppress(OSError):
+            fcntl.flock(fd, fcntl.LOCK_UN)
+        os.close(fd)

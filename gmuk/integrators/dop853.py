@@ -47,11 +47,11 @@ class DOP853(RungeKuttaMethod):
     continuous extension of order 7 (3 more evaluations per step that has outputs inside).
 
     The error estimate combines the embedded formulas of orders 5 and 3 as in Hairer's
-    ``dop853.f``: ``err = |h| ‖e₅‖² / √(‖e₅‖² + 0.01 ‖e₃‖²)`` (weighted RMS norms). A step with
-    output times inside it is accepted only if the continuous extension also meets the
-    tolerance, estimated from its defect (one more evaluation, :meth:`interpolant_error`):
-    Runge–Kutta–Munthe-Kaas step ends are often far more accurate than the extension between
-    them, which the step-end estimate cannot see.
+    ``dop853.f``: ``err = |h| ‖e₅‖² / √(‖e₅‖² + w ‖e₃‖²)`` (weighted RMS norms), with
+    w = :attr:`e3_weight` = 0.01. A step with output times inside it is accepted only if the
+    continuous extension also meets the tolerance, estimated from its defect (one more
+    evaluation, :meth:`interpolant_error`): Runge–Kutta–Munthe-Kaas step ends are often far
+    more accurate than the extension between them, which the step-end estimate cannot see.
     """
 
     name = "DOP853"
@@ -73,6 +73,8 @@ class DOP853(RungeKuttaMethod):
     #: its norm to a bound on the extension's error (see :meth:`interpolant_error`).
     defect_node: ClassVar[float] = 0.95
     defect_gain: ClassVar[float] = 0.18
+    #: Weight of the order-3 estimate in the combined error (Hairer's ``dop853.f``).
+    e3_weight: ClassVar[float] = 0.01
 
     def error_norm(self, K: FloatArray, h: float, scale: FloatArray) -> float:
         E5 = self.E
@@ -82,7 +84,7 @@ class DOP853(RungeKuttaMethod):
         n5, n3 = float(e5 @ e5), float(e3 @ e3)
         if n5 == 0.0 and n3 == 0.0:
             return 0.0
-        return float(abs(h) * n5 / np.sqrt((n5 + 0.01 * n3) * scale.size))
+        return float(abs(h) * n5 / np.sqrt((n5 + self.e3_weight * n3) * scale.size))
 
     def interpolant(
         self, f: RHS, t: float, y: FloatArray, h: float, K: FloatArray, y1: FloatArray
