@@ -31,6 +31,11 @@ def test_the_python_example_runs_and_holds_its_pin(tmp_path, monkeypatch, capsys
     exec(compile(example, "README.md", "exec"), namespace)
     printed = capsys.readouterr().out
     assert printed.startswith("max |A ν̇ − b| = ") and "pin drift = " in printed
+    # the figures the README quotes are the ones the example prints
+    residual, drift = re.findall(r"= ([0-9.e+-]+)", printed)
+    text = " ".join(README.split())
+    assert f"largest constraint residual ({residual} here)" in text
+    assert f"10 s ({drift} m at the default tolerances)" in text
     traj = namespace["traj"]
     assert traj.success and len(traj) == 501
     assert traj.residual.max() < 1e-12 and np.abs(namespace["pin_N"]).max() < 1e-7
