@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from gmuk._forms import DeclaresForms
 from gmuk._frozen import FreezesInSystem
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
@@ -66,7 +67,7 @@ class Baumgarte:
         return Baumgarte(alpha=2.0 * omega_n, beta=omega_n**2)
 
 
-class Constraint(FreezesInSystem, abc.ABC):
+class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
     """A set of s constraint rows ``A ν̇ = b`` on some bodies.
 
     Subclass it and implement :meth:`rows`: every constraint, whatever its kind, gives its
@@ -95,6 +96,7 @@ class Constraint(FreezesInSystem, abc.ABC):
 
     #: The kinds of body this constraint can act on (default: every kind).
     body_kinds: ClassVar[frozenset[BodyKind]] = frozenset(BodyKind)
+    _numeric_methods: ClassVar[tuple[str, ...]] = ("rows",)
     _bodies: tuple[Body | str, ...]
     _name: str
     _cached_indices: tuple[object, tuple[int, ...]] | None = None

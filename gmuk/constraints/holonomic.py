@@ -234,6 +234,8 @@ class HolonomicConstraint(_Differentiable):
     ...         return np.array([np.dot(x_a - x_b, x_a - x_b) - self.d**2])
     """
 
+    _numeric_methods = ("rows", "residual")
+
     @abc.abstractmethod
     def residual(self, q: Config, t: float) -> Any:
         """φ(q, t), shape (s,): zero when the constraint holds."""
@@ -279,6 +281,8 @@ class NonholonomicConstraint(_Differentiable):
         Scales for the finite-difference steps, as for :class:`HolonomicConstraint`.
     name : str, optional
     """
+
+    _numeric_methods = ("rows", "residual")
 
     @abc.abstractmethod
     def residual(self, q: Config, nu: Config, t: float) -> Any:

@@ -50,6 +50,8 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from gmuk._casadi import casadi, column
+from gmuk._forms import Forms
 from gmuk._validation import FloatArray, as_array, real_number
 from gmuk.bodies import BodyKind, SlackCoordinate
 from gmuk.constraints.base import Baumgarte
@@ -158,6 +160,7 @@ class InequalityConstraint(_Differentiable):
 
     #: Bodies of every kind may carry an inequality (its own coordinates are slack bodies).
     body_kinds: ClassVar[frozenset[BodyKind]] = frozenset(BodyKind)
+    _numeric_methods: ClassVar[tuple[str, ...]] = ("rows", "value")
     _physical: tuple[Body | str, ...]
     _bounds: tuple[Bound, ...]
     _slack_cache: tuple[object, tuple[int, ...]] | None = None
@@ -459,6 +462,7 @@ class PlaneBound(InequalityConstraint):
     """
 
     body_kinds: ClassVar[frozenset[BodyKind]] = frozenset({BodyKind.RIGID, BodyKind.POINT})
+    _forms = Forms(compiled="its rows are called back from the compiled loop", symbolic=True)
 
     def __init__(
         self,
@@ -495,6 +499,11 @@ class PlaneBound(InequalityConstraint):
         """n̂ · r_N (m)."""
         qb = q[0]
         return float(self.normal @ (qb[:3, 3] if qb.shape == (4, 4) else qb))
+
+    def casadi_value(self, q: tuple[Any, ...], nu: tuple[Any, ...], t: Any) -> Any:
+        """The symbolic form of :meth:`value` (CasADi scalar)."""
+        qb = q[0]
+        return column(self.normal).T @ (qb[:3, 3] if qb.shape == (4, 4) else qb)
 
     def jacobian(self, q: Config, nu: Config, t: float) -> FloatArray:
         """n̂ (point mass) or [0, Rᵀn̂] (rigid body, [ω; v] columns)."""
@@ -563,6 +572,8 @@ class TrackingErrorBound(InequalityConstraint):
     """
 
     body_kinds: ClassVar[frozenset[BodyKind]] = frozenset({BodyKind.POINT})
+    _numeric_methods = ("rows", "value", "errors", "reference_kinematics")
+    _forms = Forms(compiled="its rows are called back from the compiled loop", symbolic=True)
     _ref_cache: tuple[float, tuple[FloatArray, FloatArray, FloatArray]] | None = None
 
     def __init__(
@@ -646,6 +657,20 @@ class TrackingErrorBound(InequalityConstraint):
         if self.form == "norm":
             return float(np.linalg.norm(err)) - float(d)
         return 0.5 * (float(err @ err) - float(d) ** 2)
+
+    def casadi_value(self, q: tuple[Any, ...], nu: tuple[Any, ...], t: Any) -> Any:
+        """The symbolic form of :meth:`value` (CasADi scalar), at a numeric time t (the
+        reference is evaluated numerically: the transcription then goes element by
+        element)."""
+        ca = casadi()
+        if not isinstance(t, (int, float, np.floating)):
+            raise DefinitionError(f"TrackingErrorBound {self.name!r} needs a numeric time")
+        r_r, v_r, _ = self.reference_kinematics(float(t))
+        err = q[0] - column(r_r) if self.quantity == "position" else nu[0] - column(v_r)
+        bound = float(self.bound(float(t))[0])
+        if self.form == "norm":
+            return ca.norm_2(err) - bound
+        return 0.5 * (ca.sumsqr(err) - bound**2)
 
     def jacobian(self, q: Config, nu: Config, t: float) -> FloatArray:
         """errorᵀ/‖error‖ (Eqs. 107, 109), or errorᵀ for the squared form."""

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._forms import Forms
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Constraint
@@ -76,6 +77,12 @@ class ConfigurationTrackingT2(TangentBundleConstraint):
     name : str, optional
     """
 
+    _forms = Forms(
+        compiled="its rows are called back from the compiled loop",
+        symbolic="gives acceleration rows only: gmuk.optimize transcribes holonomic, "
+        "nonholonomic and inequality constraints",
+    )
+
     def __init__(
         self, body: Body | str, reference: ReferenceTrajectory, *, name: str | None = None
     ) -> None:
@@ -125,6 +132,12 @@ class VirtualPairT2(TangentBundleConstraint):
     reference : ReferenceTrajectory
     name : str, optional
     """
+
+    _forms = Forms(
+        compiled="its rows are called back from the compiled loop",
+        symbolic="gives acceleration rows only: gmuk.optimize transcribes holonomic, "
+        "nonholonomic and inequality constraints",
+    )
 
     def __init__(
         self,

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from gmuk._forms import DeclaresForms
 from gmuk._frozen import FreezesInSystem
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
 __all__ = ["Controller"]
 
 
-class Controller(FreezesInSystem, abc.ABC):
+class Controller(FreezesInSystem, DeclaresForms, abc.ABC):
     """A feedback law producing control wrenches.
 
     Parameters
@@ -46,6 +47,7 @@ class Controller(FreezesInSystem, abc.ABC):
     uses_modeled_acceleration: ClassVar[bool] = False
     #: The kinds of body this controller can act on (default: every kind).
     body_kinds: ClassVar[frozenset[BodyKind]] = frozenset(BodyKind)
+    _numeric_methods: ClassVar[tuple[str, ...]] = ("control",)
     _bodies: tuple[Body | str, ...]
     _name: str
     n_states: int
@@ -73,7 +75,9 @@ class Controller(FreezesInSystem, abc.ABC):
 
     def _compiled_term(self) -> tuple[int, FloatArray] | None:
         """How the compiled step loop evaluates this controller (gmuk.control._kernels: a
-        code and packed parameters), or None when it is called in Python (the default)."""
+        code and packed parameters), or None when it is called in Python (the default). A
+        built-in controller returns its term only when its ``control`` is not overridden
+        (:meth:`_methods_are`)."""
         return None
 
     def initial_state(self) -> FloatArray:

@@ -10,6 +10,14 @@ constraint solve does not see; McCann 2020, Chapter 5).
 A model declares the kinds of body it acts on in :attr:`ForceModel.acts_on`; by default the
 kinds whose method it implements (``wrench`` → rigid bodies, ``force`` → point masses). The
 System checks that declaration once, when it is built.
+
+A built-in model with a compiled form writes its physics once, as a numba kernel beside its
+class with the signature of :func:`gmuk.forces._kernels.apply_term` (less the code):
+``kernel(rigid, t, g, V, m, J, p, field, out) -> status``. The class names it ``_kernel`` and
+packs its parameters in ``_kernel_params(body)``; its ``wrench``/``force`` call it through
+:meth:`ForceModel._kernel_load` and the compiled step loop through ``apply_term``, which
+dispatches on the code :meth:`ForceModel._compiled_term` finds for the kernel. Such a kernel
+writes a force at the centre of mass with :func:`com_load`.
 """
 
 from __future__ import annotations
@@ -19,19 +27,43 @@ from typing import TYPE_CHECKING, Any, ClassVar, cast
 
 import numpy as np
 
+from gmuk._forms import DeclaresForms
 from gmuk._frozen import FreezesInSystem
+from gmuk._numba import njit
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
-from gmuk.errors import DefinitionError
+from gmuk.errors import DefinitionError, DomainError
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
     from gmuk.state import State
 
-__all__ = ["ForceModel"]
+__all__ = ["ForceModel", "com_load"]
+
+# the kernels' arguments that a body or a model does not have (read-only, as the compiled
+# loop passes its field data: the Python calls then use the loop's compiled kernels)
+_NO_INERTIA = np.zeros((3, 3))
+_NO_FIELD = np.zeros(1)
+_NO_FIELD.setflags(write=False)
 
 
-class ForceModel(FreezesInSystem):
+@njit(cache=True)
+def com_load(rigid, g, fx, fy, fz, out):  # type: ignore[no-untyped-def]
+    """Write a force f_N = (fx, fy, fz) (N, frame N) acting at the centre of mass into a force
+    kernel's ``out``: the body-frame wrench ``[0; Rᵀ f_N]`` (6,) of a rigid body at pose
+    ``g`` (4, 4), or f_N itself (3,) for a point mass."""
+    if rigid:
+        out[0] = out[1] = out[2] = 0.0
+        out[3] = g[0, 0] * fx + g[1, 0] * fy + g[2, 0] * fz
+        out[4] = g[0, 1] * fx + g[1, 1] * fy + g[2, 1] * fz
+        out[5] = g[0, 2] * fx + g[1, 2] * fy + g[2, 2] * fz
+    else:
+        out[0] = fx
+        out[1] = fy
+        out[2] = fz
+
+
+class ForceModel(FreezesInSystem, DeclaresForms):
     """A source of wrenches on bodies.
 
     Subclasses implement :meth:`wrench` for rigid bodies and/or :meth:`force` for point
@@ -55,6 +87,9 @@ class ForceModel(FreezesInSystem):
     """
 
     acts_on: ClassVar[frozenset[BodyKind]] = frozenset()
+    _numeric_methods = ("wrench", "force", "wrenches")
+    #: A built-in model's compiled kernel (see the module docstring); none by default.
+    _kernel: ClassVar[Any]
     _bodies: tuple[Body | str, ...] | None
     _name: str
     modeled: bool
@@ -140,17 +175,71 @@ class ForceModel(FreezesInSystem):
         raise DefinitionError(f"{self.name} does not act on point masses")
 
     def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
-        """How the compiled step loop evaluates this model on ``body``: (code of
-        :mod:`gmuk.forces._kernels`, parameters, field data vector or None), or None when
-        the model has no compiled form and is called in Python. Built-in models return their
-        term only when their ``force``/``wrench``/``wrenches`` are not overridden."""
-        return None
+        """How the compiled step loop evaluates this model on ``body``: (code of its kernel in
+        :mod:`gmuk.forces._kernels`, parameters, field data vector or None), or None when the
+        model has no compiled form and is called in Python. A model has the compiled form of
+        the class that defines its ``_kernel`` when its ``wrench``, ``force`` and
+        ``wrenches`` are that class's (a subclass that overrides one of them has none), and
+        when ``_kernel_params(body)`` packs parameters for the body."""
+        kernel = self._declared_form("_kernel")
+        if kernel is None:
+            return None
+        from gmuk.forces._kernels import CODES
 
-    def _methods_are(self, cls: type) -> bool:
-        """Whether this object's wrench, force and wrenches are those of ``cls`` (a
-        subclass that overrides any of them gets no compiled term)."""
-        t = type(self)
-        return all(getattr(t, k) is getattr(cls, k) for k in ("wrench", "force", "wrenches"))
+        code = CODES.get(kernel)
+        packed = self._kernel_params(body) if code is not None else None
+        if code is None or packed is None:
+            return None
+        params, data = packed
+        return code, tuple(float(v) for v in params), data
+
+    def _kernel_params(self, body: Body) -> tuple[Any, Any] | None:
+        """The parameters of :attr:`_kernel` for ``body`` and the field data vector (or
+        None); None when the kernel cannot evaluate this model on ``body``."""
+        raise DefinitionError(f"{type(self).__name__} has no compiled kernel")
+
+    def _kernel_load(self, rigid: bool, t: float, x: Any, v: Any, body: Body) -> FloatArray:
+        """This model's kernel on one body, as the compiled loop calls it: the body-frame
+        wrench [L; f] (6,) of a rigid body at pose ``x`` = g_NB with twist ``v`` = V_B, or
+        the force f_N (3,) on a point mass at ``x`` = r_N with velocity ``v`` = v_N.
+
+        Raises
+        ------
+        DomainError
+            When the kernel returns a nonzero status (see :meth:`_kernel_failure`).
+        """
+        packed = self._kernel_params(body)
+        if packed is None:
+            raise DefinitionError(
+                f"{self.name}: the compiled kernel of {type(self).__name__} cannot evaluate "
+                f"{body.kind} body {body.name!r}"
+            )
+        params, data = packed
+        if rigid:
+            g = np.array(x, dtype=float)
+            V = np.array(v, dtype=float)
+            J = np.array(cast("RigidBody", body).inertia, dtype=float)
+            out = np.empty(6)
+        else:
+            g = np.eye(4)
+            g[:3, 3] = x
+            V = np.zeros(6)
+            V[:3] = v
+            J = _NO_INERTIA
+            out = np.empty(3)
+        p = np.array(params, dtype=float)
+        field = _NO_FIELD if data is None else data
+        status = self._kernel(rigid, float(t), g, V, float(body.mass), J, p, field, out)
+        if status != 0:
+            raise self._kernel_failure(int(status), float(t), g)
+        return out
+
+    def _kernel_failure(self, status: int, t: float, g: FloatArray) -> Exception:
+        """The error for a nonzero status of :attr:`_kernel` at time t and pose g."""
+        return DomainError(
+            f"{self.name}: the force has no finite value at r_N = {g[:3, 3].tolist()} m, "
+            f"t = {t!r} s (kernel status {status})"
+        )
 
     def wrenches(self, state: State, bodies: Sequence[Body]) -> list[FloatArray]:
         """Wrenches on each of ``bodies`` at ``state``: [L; f] (6,) in B per rigid body,

@@ -12,31 +12,60 @@
 
   Errata (docs/errata.rst): correct as printed with r_B = Rᵀr (Eqs. 33/52 write inertial r,
   where J must be R J Rᵀ); both match point-cloud quadrature to 1e-11.
+
+Each model's formula is written once, in the numba kernel beside its class
+(:func:`point_mass_load`, :func:`gravity_gradient_load`, :func:`harmonic_point_load`): the
+class's ``wrench``/``force`` call it, and so does the compiled step loop
+(:func:`gmuk.forces._kernels.apply_term`).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._casadi import casadi
+from gmuk._forms import Forms
+from gmuk._numba import njit
 from gmuk._validation import FloatArray, real_number
 from gmuk.bodies import BodyKind
 from gmuk.celestial import CelestialBody, UniformRotation
-from gmuk.errors import DefinitionError
-from gmuk.forces import _kernels
-from gmuk.forces.base import ForceModel
+from gmuk.errors import DefinitionError, GmukError
+from gmuk.forces.base import ForceModel, com_load
+from gmuk.gravity._kernels import acceleration_at
 from gmuk.gravity.field import SphericalHarmonicField
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
 
-__all__ = ["GravityGradient", "PointMassGravity", "SphericalHarmonicGravity"]
+__all__ = [
+    "GravityGradient",
+    "PointMassGravity",
+    "SphericalHarmonicGravity",
+    "gravity_gradient_load",
+    "gravity_gradient_wrench",
+    "harmonic_point_load",
+    "point_mass_load",
+]
 
 
 def _check_mu(mu: float) -> float:
     return real_number(mu, "mu (gravitational parameter, m³/s²)", positive=True)
+
+
+@njit(cache=True)
+def point_mass_load(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
+    """:class:`PointMassGravity`'s kernel: ``f_N = −μ m r_N/|r_N|³`` at the centre of mass of a
+    body of mass m at ``g[:3, 3]`` (m), written into ``out`` as a force kernel does
+    (:func:`~gmuk.forces.base.com_load`). Parameters ``p = (μ,)`` (m³/s²). Returns 0."""
+    x, y, z = g[0, 3], g[1, 3], g[2, 3]
+    rn = math.sqrt(x * x + y * y + z * z)
+    k = -p[0] * m / rn**3
+    com_load(rigid, g, k * x, k * y, k * z, out)
+    return 0
 
 
 class PointMassGravity(ForceModel):
@@ -51,6 +80,9 @@ class PointMassGravity(ForceModel):
     modeled : bool
     """
 
+    _kernel = staticmethod(point_mass_load)
+    _forms = Forms(compiled=True, symbolic=True)
+
     def __init__(
         self, mu: float, *, bodies: Sequence[Body | str] | None = None, modeled: bool = True
     ) -> None:
@@ -58,18 +90,67 @@ class PointMassGravity(ForceModel):
         self.mu = _check_mu(mu)
 
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
-        """[0; m Rᵀ a_N] in the body frame (N·m, N)."""
-        return np.concatenate([np.zeros(3), g_NB[:3, :3].T @ self.force(t, g_NB[:3, 3], V_B, body)])
+        """[0; Rᵀ f_N] in the body frame (N·m, N) (:func:`point_mass_load`)."""
+        return self._kernel_load(True, t, g_NB, V_B, body)
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
-        """``−μ m r_N/|r_N|³`` (N)."""
-        rn = float(np.sqrt(r_N @ r_N))
-        return (-self.mu * body.mass / rn**3) * r_N
+        """``−μ m r_N/|r_N|³`` (N) (:func:`point_mass_load`)."""
+        return self._kernel_load(False, t, r_N, v_N, body)
 
-    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
-        if not self._methods_are(PointMassGravity):
-            return None
-        return _kernels.POINT_MASS, (self.mu,), None
+    def _kernel_params(self, body: Body) -> tuple[tuple[float, ...], None]:
+        return (self.mu,), None
+
+    def casadi_force(self, t: Any, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force` (CasADi, 3×1)."""
+        ca = casadi()
+        rn2 = ca.sumsqr(r_N)
+        return (-self.mu * body.mass) * r_N / (rn2 * ca.sqrt(rn2))
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` (CasADi, 6×1)."""
+        ca = casadi()
+        f = PointMassGravity.casadi_force(self, t, g_NB[:3, 3], None, body)
+        return ca.vertcat(ca.DM.zeros(3, 1), g_NB[:3, :3].T @ f)
+
+
+@njit(cache=True)
+def gravity_gradient_wrench(g, mu, m, J, out):  # type: ignore[no-untyped-def]
+    """Write McCann (2020) Eq. 23's body-frame wrench [L; f] (N·m, N) of a rigid body of mass
+    m and central inertia J (3, 3) at pose g (4, 4) in the field of a point mass μ at the
+    origin into ``out`` (6,): with r_B = Rᵀ r,
+
+    ``L = 3μ/r⁵ r_B × J r_B``,
+    ``f = −μm/r³ (r_B + 3/(m r²) (J r_B + ½(tr J − 5 r_Bᵀ J r_B / r²) r_B))``.
+    """
+    x = g[0, 0] * g[0, 3] + g[1, 0] * g[1, 3] + g[2, 0] * g[2, 3]
+    y = g[0, 1] * g[0, 3] + g[1, 1] * g[1, 3] + g[2, 1] * g[2, 3]
+    z = g[0, 2] * g[0, 3] + g[1, 2] * g[1, 3] + g[2, 2] * g[2, 3]
+    jx = J[0, 0] * x + J[0, 1] * y + J[0, 2] * z
+    jy = J[1, 0] * x + J[1, 1] * y + J[1, 2] * z
+    jz = J[2, 0] * x + J[2, 1] * y + J[2, 2] * z
+    r2 = x * x + y * y + z * z
+    rn = math.sqrt(r2)
+    k = 3.0 * mu / (r2 * r2 * rn)
+    out[0] = k * (y * jz - z * jy)
+    out[1] = k * (z * jx - x * jz)
+    out[2] = k * (x * jy - y * jx)
+    c = 0.5 * (J[0, 0] + J[1, 1] + J[2, 2] - 5.0 * (x * jx + y * jy + z * jz) / r2)
+    a = 3.0 / (m * r2)
+    kf = -mu * m / (r2 * rn)
+    out[3] = kf * (x + a * (jx + c * x))
+    out[4] = kf * (y + a * (jy + c * y))
+    out[5] = kf * (z + a * (jz + c * z))
+
+
+@njit(cache=True)
+def gravity_gradient_load(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
+    """:class:`GravityGradient`'s kernel: Eq. 23 on a rigid body
+    (:func:`gravity_gradient_wrench`), the point-mass force (:func:`point_mass_load`) on a
+    point mass. Parameters ``p = (μ,)`` (m³/s²). Returns 0."""
+    if rigid:
+        gravity_gradient_wrench(g, p[0], m, J, out)
+        return 0
+    return point_mass_load(rigid, t, g, V, m, J, p, field, out)
 
 
 class GravityGradient(ForceModel):
@@ -94,6 +175,9 @@ class GravityGradient(ForceModel):
     Systems* (2018), §4.4.
     """
 
+    _kernel = staticmethod(gravity_gradient_load)
+    _forms = Forms(compiled=True, symbolic="no CasADi form of Eq. 23 is written yet")
+
     def __init__(
         self, mu: float, *, bodies: Sequence[Body | str] | None = None, modeled: bool = True
     ) -> None:
@@ -101,20 +185,16 @@ class GravityGradient(ForceModel):
         self.mu = _check_mu(mu)
 
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
-        """[L_G; f_G] in the body frame (N·m, N); compiled
-        (:func:`gmuk.forces._kernels.gravity_gradient_wrench`)."""
-        out = np.empty(6)
-        _kernels.gravity_gradient_wrench(g_NB, self.mu, body.mass, body.inertia, out)
-        return out
+        """[L_G; f_G] in the body frame (N·m, N) (:func:`gravity_gradient_wrench`)."""
+        return self._kernel_load(True, t, g_NB, V_B, body)
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
-        """The point-mass force ``−μ m r_N/|r_N|³`` on a particle (N)."""
-        return (-self.mu * body.mass / float(np.sqrt(r_N @ r_N)) ** 3) * r_N
+        """The point-mass force ``−μ m r_N/|r_N|³`` on a particle (N)
+        (:func:`point_mass_load`)."""
+        return self._kernel_load(False, t, r_N, v_N, body)
 
-    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
-        if not self._methods_are(GravityGradient):
-            return None
-        return _kernels.GRAVITY_GRADIENT, (self.mu,), None
+    def _kernel_params(self, body: Body) -> tuple[tuple[float, ...], None]:
+        return (self.mu,), None
 
 
 def _shipped_body(name: str, degree: int | None) -> CelestialBody:
@@ -124,6 +204,29 @@ def _shipped_body(name: str, degree: int | None) -> CelestialBody:
     field = gravity.load(name, degree)
     body = next(i.body for i in gravity.available() if i.name.upper() == name.upper())
     return CelestialBody.moon(field=field) if body == "Moon" else CelestialBody.earth(field=field)
+
+
+@njit(cache=True)
+def harmonic_point_load(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
+    """:class:`SphericalHarmonicGravity`'s kernel on a point mass: ``f_N = m R_FNᵀ ∇U(R_FN r_N)``
+    with F spinning uniformly about N's third axis, ``R_FN = R₃(η₀ + ω t)``. Parameters
+    ``p = (η₀, ω)`` (rad, rad/s); ``field`` is the field's data vector
+    (:mod:`gmuk.gravity._kernels`). Returns 0, or the field kernel's nonzero status."""
+    x, y, z = g[0, 3], g[1, 3], g[2, 3]
+    eta = p[0] + p[1] * t
+    c, s = math.cos(eta), math.sin(eta)
+    r_F = np.empty(3)
+    r_F[0] = c * x + s * y
+    r_F[1] = -s * x + c * y
+    r_F[2] = z
+    a_F = np.empty(3)
+    status = acceleration_at(field, r_F, a_F, True)
+    if status != 0:
+        return status
+    fx = m * (c * a_F[0] - s * a_F[1])
+    fy = m * (s * a_F[0] + c * a_F[1])
+    com_load(rigid, g, fx, fy, m * a_F[2], out)
+    return 0
 
 
 class SphericalHarmonicGravity(ForceModel):
@@ -175,7 +278,15 @@ class SphericalHarmonicGravity(ForceModel):
     McCann (2020), Eqs. 42 and 59 approximate this with the angular factor frozen at the
     centre-of-mass direction and the radial-only Eq. 25; see
     :class:`~gmuk.forces.thesis_gravity.ThesisRadialHarmonicGravity` and the errata.
+
+    On a point mass about a uniformly spinning central body
+    (:class:`~gmuk.celestial.UniformRotation`) in a :class:`~gmuk.gravity.SphericalHarmonicField`
+    the force is :func:`harmonic_point_load`, the kernel the compiled loop calls; other
+    rotation models and fields are evaluated in Python through the field's ``acceleration``.
     """
+
+    _kernel = staticmethod(harmonic_point_load)
+    _forms = Forms(compiled=True, symbolic="no CasADi form of a spherical-harmonic field yet")
 
     def __init__(
         self,
@@ -223,24 +334,36 @@ class SphericalHarmonicGravity(ForceModel):
         return np.concatenate([L, f_B])
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
-        """m ∇U at r_N, in N (N)."""
+        """m R_FNᵀ ∇U(R_FN r_N), in N (N) (:func:`harmonic_point_load` where it applies)."""
+        if self._kernel_params(body) is not None:
+            return self._kernel_load(False, t, r_N, v_N, body)
         R_FN = self.central_body.rotation.R_FN(t)
         return body.mass * (R_FN.T @ self.field.acceleration(R_FN @ r_N))
 
-    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
-        """Point masses in a field with a compiled kernel, the central body spinning
-        uniformly (:class:`~gmuk.celestial.UniformRotation`); None otherwise."""
+    def _kernel_params(self, body: Body) -> tuple[tuple[float, float], Any] | None:
+        """(η₀, ω) and the field's data for a point mass in a
+        :class:`~gmuk.gravity.SphericalHarmonicField` about a central body spinning uniformly
+        (:class:`~gmuk.celestial.UniformRotation`); None otherwise (rigid bodies, other
+        rotation models and fields: Python)."""
         rot = self.central_body.rotation
         data = getattr(self.field, "_data", None)
         if (
             body.kind is not BodyKind.POINT
-            or not self._methods_are(SphericalHarmonicGravity)
             or type(rot) is not UniformRotation
             or type(self.field) is not SphericalHarmonicField
             or data is None
         ):
             return None
-        return _kernels.HARMONIC_POINT, (float(rot.angle0), float(rot.rate)), data
+        return (float(rot.angle0), float(rot.rate)), data
+
+    def _kernel_failure(self, status: int, t: float, g: FloatArray) -> Exception:
+        """The field's own error at the failing point (what ``field.acceleration`` raises)."""
+        R_FN = self.central_body.rotation.R_FN(t)
+        try:
+            self.field.acceleration(R_FN @ g[:3, 3])
+        except GmukError as exc:
+            return exc
+        return super()._kernel_failure(status, t, g)
 
     def finite_size_force(self, t: float, g_NB: FloatArray, body: RigidBody) -> FloatArray:
         """The second-order finite-size force ``½ ∇³U : Π`` alone, in the body frame (N).

@@ -1,4 +1,10 @@
-"""Simple mechanical force models: applied wrenches, springs and dampers, uniform gravity."""
+"""Simple mechanical force models: applied wrenches, springs and dampers, uniform gravity.
+
+:class:`UniformGravity` and :class:`LinearSpringDamper` are written once each, in the numba
+kernel beside the class (:func:`uniform_load`, :func:`spring_load`) that their Python methods
+and the compiled step loop (:func:`gmuk.forces._kernels.apply_term`) both call; their CasADi
+forms, and those of the other models here, are methods of the classes.
+"""
 
 from __future__ import annotations
 
@@ -7,11 +13,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._casadi import casadi, column
+from gmuk._forms import Forms
+from gmuk._numba import njit
 from gmuk._validation import FloatArray, as_array, real_number
 from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError, GmukError
-from gmuk.forces import _kernels
-from gmuk.forces.base import ForceModel
+from gmuk.forces.base import ForceModel, com_load
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
@@ -23,6 +31,8 @@ __all__ = [
     "SlackDamping",
     "SpringDamper",
     "UniformGravity",
+    "spring_load",
+    "uniform_load",
 ]
 
 STANDARD_GRAVITY = 9.80665  # m/s², CGPM 1901
@@ -43,6 +53,11 @@ class AppliedWrench(ForceModel):
         Whether the constraint solve knows it (default True).
     name : str, optional
     """
+
+    _forms = Forms(
+        compiled="a function of time given in Python: called back from the compiled loop",
+        symbolic=True,
+    )
 
     def __init__(
         self,
@@ -88,6 +103,28 @@ class AppliedWrench(ForceModel):
         force is taken as given in N (a point mass has no body frame)."""
         return np.asarray(self._fun(t), dtype=float)
 
+    def casadi_force(self, t: float, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force`: the given force at the (numeric) time t."""
+        return column(AppliedWrench.force(self, t, np.zeros(3), np.zeros(3), body))
+
+    def casadi_wrench(self, t: float, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` (CasADi, 6×1) at the (numeric) time t."""
+        ca = casadi()
+        w = column(self._fun(t))
+        if self.frame == "inertial":
+            Rt = g_NB[:3, :3].T
+            return ca.vertcat(Rt @ w[:3], Rt @ w[3:])
+        return w
+
+
+@njit(cache=True)
+def uniform_load(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
+    """:class:`UniformGravity`'s kernel: ``f_N = m g_N`` at the centre of mass, written into
+    ``out`` as a force kernel does (:func:`~gmuk.forces.base.com_load`). Parameters
+    ``p = g_N`` (3 values, m/s²). Returns 0."""
+    com_load(rigid, g, m * p[0], m * p[1], m * p[2], out)
+    return 0
+
 
 class UniformGravity(ForceModel):
     """Weight in a uniform field: f_N = m g_N (no torque about the centre of mass).
@@ -98,6 +135,9 @@ class UniformGravity(ForceModel):
         Gravitational acceleration in N (m/s²); default (0, 0, −9.80665).
     bodies : sequence, optional
     """
+
+    _kernel = staticmethod(uniform_load)
+    _forms = Forms(compiled=True, symbolic=True)
 
     def __init__(
         self,
@@ -110,17 +150,43 @@ class UniformGravity(ForceModel):
         self.g_N = as_array(g_N, (3,), "g_N", batch=False)
 
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
-        """[0; m Rᵀ g_N] in the body frame (N·m, N)."""
-        return np.concatenate([np.zeros(3), body.mass * (g_NB[:3, :3].T @ self.g_N)])
+        """[0; Rᵀ m g_N] in the body frame (N·m, N) (:func:`uniform_load`)."""
+        return self._kernel_load(True, t, g_NB, V_B, body)
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
-        """m g_N (N)."""
-        return body.mass * self.g_N
+        """m g_N (N) (:func:`uniform_load`)."""
+        return self._kernel_load(False, t, r_N, v_N, body)
 
-    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
-        if not self._methods_are(UniformGravity):
-            return None
-        return _kernels.UNIFORM, tuple(float(v) for v in self.g_N), None
+    def _kernel_params(self, body: Body) -> tuple[FloatArray, None]:
+        return self.g_N, None
+
+    def casadi_force(self, t: Any, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force` (CasADi, 3×1)."""
+        return body.mass * column(self.g_N)
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` (CasADi, 6×1)."""
+        ca = casadi()
+        return ca.vertcat(ca.DM.zeros(3, 1), g_NB[:3, :3].T @ (body.mass * column(self.g_N)))
+
+
+@njit(cache=True)
+def spring_load(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
+    """:class:`LinearSpringDamper`'s kernel: ``f_N = −k (r_N − r_a) − c v_N`` at the centre of
+    mass (``v_N = R v_B`` on a rigid body), written into ``out`` as a force kernel does
+    (:func:`~gmuk.forces.base.com_load`). Parameters ``p = (k, c, r_a)`` (N/m, N·s/m, 3 values
+    in m). Returns 0."""
+    if rigid:  # v_N = R v_B
+        vx = g[0, 0] * V[3] + g[0, 1] * V[4] + g[0, 2] * V[5]
+        vy = g[1, 0] * V[3] + g[1, 1] * V[4] + g[1, 2] * V[5]
+        vz = g[2, 0] * V[3] + g[2, 1] * V[4] + g[2, 2] * V[5]
+    else:
+        vx, vy, vz = V[0], V[1], V[2]
+    fx = -p[0] * (g[0, 3] - p[2]) - p[1] * vx
+    fy = -p[0] * (g[1, 3] - p[3]) - p[1] * vy
+    fz = -p[0] * (g[2, 3] - p[4]) - p[1] * vz
+    com_load(rigid, g, fx, fy, fz, out)
+    return 0
 
 
 class LinearSpringDamper(ForceModel):
@@ -143,7 +209,15 @@ class LinearSpringDamper(ForceModel):
         The bodies it acts on (default: every point mass and rigid body).
     modeled : bool
     name : str, optional
+
+    Notes
+    -----
+    The force is :func:`spring_load` (the compiled loop's kernel too); its CasADi form is
+    :meth:`casadi_force` / :meth:`casadi_wrench`.
     """
+
+    _kernel = staticmethod(spring_load)
+    _forms = Forms(compiled=True, symbolic=True)
 
     def __init__(
         self,
@@ -161,19 +235,26 @@ class LinearSpringDamper(ForceModel):
         self.anchor = as_array(anchor, (3,), "anchor", batch=False)
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
-        """−k(r_N − r_a) − c v_N (N)."""
-        return -self.k * (r_N - self.anchor) - self.c * v_N
+        """−k(r_N − r_a) − c v_N (N) (:func:`spring_load`)."""
+        return self._kernel_load(False, t, r_N, v_N, body)
 
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
-        """[0; Rᵀ f_N] at the centre of mass (N·m, N)."""
-        R = g_NB[:3, :3]
-        f_N = -self.k * (g_NB[:3, 3] - self.anchor) - self.c * (R @ V_B[3:])
-        return np.concatenate([np.zeros(3), R.T @ f_N])
+        """[0; Rᵀ f_N] at the centre of mass (N·m, N) (:func:`spring_load`)."""
+        return self._kernel_load(True, t, g_NB, V_B, body)
 
-    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
-        if not self._methods_are(LinearSpringDamper):
-            return None
-        return _kernels.SPRING, (self.k, self.c, *(float(v) for v in self.anchor)), None
+    def _kernel_params(self, body: Body) -> tuple[tuple[float, ...], None]:
+        return (self.k, self.c, *(float(v) for v in self.anchor)), None
+
+    def casadi_force(self, t: Any, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force` (CasADi, 3×1)."""
+        return -self.k * (r_N - column(self.anchor)) - self.c * v_N
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` (CasADi, 6×1)."""
+        ca = casadi()
+        R = g_NB[:3, :3]
+        f_N = LinearSpringDamper.casadi_force(self, t, g_NB[:3, 3], R @ V_B[3:], body)
+        return ca.vertcat(ca.DM.zeros(3, 1), R.T @ f_N)
 
 
 class SlackDamping(ForceModel):
@@ -199,6 +280,10 @@ class SlackDamping(ForceModel):
     """
 
     acts_on = frozenset({BodyKind.SLACK})
+    _forms = Forms(
+        compiled="acts on slack coordinates, whose loads the compiled loop calls back",
+        symbolic="gmuk.optimize transcribes no slack coordinates",
+    )
 
     def __init__(
         self,
@@ -241,6 +326,7 @@ class SpringDamper(ForceModel):
     """
 
     acts_on = frozenset({BodyKind.RIGID, BodyKind.POINT})
+    _forms = Forms(compiled="couples two bodies: called back from the compiled loop", symbolic=True)
 
     def __init__(
         self,
@@ -301,3 +387,40 @@ class SpringDamper(ForceModel):
             return f_N
         f_B = state.pose(body)[:3, :3].T @ f_N
         return np.concatenate([np.cross(p_B, f_B), f_B])
+
+    def casadi_wrenches(
+        self, t: Any, q: tuple[Any, ...], nu: tuple[Any, ...], bodies: tuple[Body, ...]
+    ) -> list[Any]:
+        """The symbolic form of :meth:`wrenches` (CasADi columns, one per body)."""
+        ca = casadi()
+        x_a, v_a = _casadi_point(q[0], nu[0], bodies[0], self.point_a)
+        if self.anchored:
+            x_b, v_b = column(self.point_b), ca.DM.zeros(3, 1)
+        else:
+            x_b, v_b = _casadi_point(q[1], nu[1], bodies[1], self.point_b)
+        d = x_b - x_a
+        length = ca.norm_2(d)
+        u = d / length
+        tension = self.k * (length - self.l0) + self.c * ca.dot(u, v_b - v_a)
+        f_a = tension * u
+        out = [_casadi_to_body(q[0], bodies[0], self.point_a, f_a)]
+        if not self.anchored:
+            out.append(_casadi_to_body(q[1], bodies[1], self.point_b, -f_a))
+        return out
+
+
+def _casadi_point(q: Any, nu: Any, body: Body, p_B: Any) -> tuple[Any, Any]:
+    """World position and velocity of a body point (as SpringDamper._point), in CasADi."""
+    if body.kind is BodyKind.RIGID:
+        R, p = q[:3, :3], column(p_B)
+        return q[:3, 3] + R @ p, R @ (nu[3:] + casadi().cross(nu[:3], p))
+    return q, nu
+
+
+def _casadi_to_body(q: Any, body: Body, p_B: Any, f_N: Any) -> Any:
+    """A force f_N at a body point as that body's load (as SpringDamper._to_body), in CasADi."""
+    if body.kind is not BodyKind.RIGID:
+        return f_N
+    ca = casadi()
+    f_B = q[:3, :3].T @ f_N
+    return ca.vertcat(ca.cross(column(p_B), f_B), f_B)

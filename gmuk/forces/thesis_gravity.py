@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.special import gammaln
 
+from gmuk._forms import Forms
 from gmuk._validation import FloatArray
 from gmuk.errors import DefinitionError, DomainError
 from gmuk.forces.base import ForceModel
@@ -163,6 +164,12 @@ class ThesisRadialHarmonicGravity(ForceModel):
     ----------
     McCann (2020), Eqs. (23), (25)–(28), (33), (40)–(42), (52), (58)–(59), (60)–(62).
     """
+
+    _forms = Forms(
+        compiled="kept in Python: a printed approximation for reproducing Chapter 3, called "
+        "back from the compiled loop",
+        symbolic="kept in Python: a printed approximation, not for optimisation",
+    )
 
     def __init__(
         self,

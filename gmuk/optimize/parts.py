@@ -3,9 +3,13 @@
 The direct transcription needs every model as a CasADi expression of symbolic states, so that
 CasADi can differentiate it exactly. gmuk finds a part's form in this order:
 
-1. a method on the part itself (the protocol below);
-2. a form registered for the part's exact class with :func:`register_casadi_form` (gmuk
-   registers its built-in parts this way);
+1. a method on the part's class (the protocol below; gmuk's built-in parts have theirs), when
+   the class that defines it also defines the part's numeric methods: a subclass that does
+   not override ``wrench``/``force``/``wrenches`` (force models), ``value`` (inequalities),
+   ``residual`` (holonomic and nonholonomic constraints) or ``rows`` inherits the form; one
+   that overrides any of them does not, until it defines its own (it changed the physics the
+   form describes; :class:`gmuk._forms.DeclaresForms`);
+2. a form registered for the part's exact class with :func:`register_casadi_form`;
 3. for :class:`~gmuk.constraints.InequalityConstraint`,
    :class:`~gmuk.constraints.HolonomicConstraint` and
    :class:`~gmuk.constraints.NonholonomicConstraint` subclasses, the part's numeric
@@ -38,18 +42,12 @@ from typing import Any
 
 import numpy as np
 
+from gmuk._casadi import casadi
 from gmuk.bodies import Body, BodyKind
 from gmuk.constraints.holonomic import HolonomicConstraint, NonholonomicConstraint
-from gmuk.constraints.inequality import InequalityConstraint, PlaneBound, TrackingErrorBound
-from gmuk.errors import DefinitionError, MissingDependencyError
+from gmuk.constraints.inequality import InequalityConstraint
+from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
-from gmuk.forces.gravity import PointMassGravity
-from gmuk.forces.mechanical import (
-    AppliedWrench,
-    LinearSpringDamper,
-    SpringDamper,
-    UniformGravity,
-)
 
 __all__ = ["register_casadi_form"]
 
@@ -88,18 +86,11 @@ def register_casadi_form(cls: type, method: str) -> Callable[[Callable[..., Any]
     return deco
 
 
-def _ca() -> Any:
-    try:
-        import casadi
-    except ImportError:
-        raise MissingDependencyError(
-            'gmuk.optimize needs CasADi: pip install "gmuk[optimize]" (or pip install casadi)'
-        ) from None
-    return casadi
-
-
 def _lookup(part: Any, method: str) -> Callable[..., Any] | None:
-    own = getattr(part, method, None)
+    """The part's form ``method``: declared on its class (and not cut off by an overridden
+    numeric method), else registered for its exact class; None if neither."""
+    declared = getattr(part, "_declared_form", None)
+    own = declared(method) if declared is not None else getattr(part, method, None)
     if callable(own):
         return own
     form = _FORMS.get((type(part), method))
@@ -108,9 +99,22 @@ def _lookup(part: Any, method: str) -> Callable[..., Any] | None:
     return None
 
 
+def _cut_off(part: Any, method: str) -> str:
+    """A sentence for an error message when ``part`` has ``method`` only from a class whose
+    numeric methods it overrides; empty otherwise."""
+    cut = getattr(part, "_cut_off_form", None)
+    owner = cut(method) if cut is not None else None
+    if owner is None:
+        return ""
+    return (
+        f" ({type(part).__name__} overrides a numeric method of {owner.__name__}, so it does "
+        f"not inherit {owner.__name__}.{method}: the form would describe the old physics)"
+    )
+
+
 def _as_column(value: Any, who: str, rows: int | None) -> Any:
     """A CasADi SX column from what a part returned (SX, DM, numbers, or arrays of them)."""
-    ca = _ca()
+    ca = casadi()
     try:
         if isinstance(value, (ca.SX, ca.DM)):
             out = ca.SX(value)
@@ -165,8 +169,9 @@ def force_terms(
         return [_as_column(w, who, b.dof) for w, b in zip(out, bodies, strict=True)]
     if type(model).wrenches is not ForceModel.wrenches:
         raise DefinitionError(
-            f"{who} couples bodies (it overrides wrenches()) and has no CasADi form; give it "
-            "casadi_wrenches(t, q, nu, bodies) or register one"
+            f"{who} couples bodies (it overrides wrenches()) and has no CasADi form"
+            f"{_cut_off(model, 'casadi_wrenches')}; give it casadi_wrenches(t, q, nu, bodies) "
+            "or register one"
         )
     terms = []
     for qi, vi, body in zip(q, nu, bodies, strict=True):
@@ -174,7 +179,8 @@ def force_terms(
         fn = _lookup(model, method)
         if fn is None:
             raise DefinitionError(
-                f"{who} has no CasADi form for {body.kind} body {body.name!r}; {_FORCE_FIX}"
+                f"{who} has no CasADi form for {body.kind} body {body.name!r}"
+                f"{_cut_off(model, method)}; {_FORCE_FIX}"
             )
         terms.append(_as_column(_call(fn, (t, qi, vi, body), who, _FORCE_FIX), who, body.dof))
     return terms
@@ -214,121 +220,3 @@ def constraint_kind(c: Any) -> str:
         "InequalityConstraint (h(q, ν, t) between bounds), a HolonomicConstraint "
         "(φ(q, t) = 0) or a NonholonomicConstraint (ψ(q, ν, t) = 0)"
     )
-
-
-# ---------------------------------------------------------------- built-in parts' forms
-
-
-def _column(x: Any) -> Any:
-    return _ca().DM(np.asarray(x, dtype=float).reshape(-1, 1))
-
-
-@register_casadi_form(LinearSpringDamper, "casadi_force")
-def _lsd_force(m: LinearSpringDamper, t: float, r_N: Any, v_N: Any, body: Body) -> Any:
-    return -m.k * (r_N - _column(m.anchor)) - m.c * v_N
-
-
-@register_casadi_form(LinearSpringDamper, "casadi_wrench")
-def _lsd_wrench(m: LinearSpringDamper, t: float, g_NB: Any, V_B: Any, body: Body) -> Any:
-    ca = _ca()
-    R = g_NB[:3, :3]
-    f_N = -m.k * (g_NB[:3, 3] - _column(m.anchor)) - m.c * (R @ V_B[3:])
-    return ca.vertcat(ca.DM.zeros(3, 1), R.T @ f_N)
-
-
-@register_casadi_form(UniformGravity, "casadi_force")
-def _ug_force(m: UniformGravity, t: float, r_N: Any, v_N: Any, body: Body) -> Any:
-    return body.mass * _column(m.g_N)
-
-
-@register_casadi_form(UniformGravity, "casadi_wrench")
-def _ug_wrench(m: UniformGravity, t: float, g_NB: Any, V_B: Any, body: Body) -> Any:
-    ca = _ca()
-    return ca.vertcat(ca.DM.zeros(3, 1), body.mass * (g_NB[:3, :3].T @ _column(m.g_N)))
-
-
-@register_casadi_form(PointMassGravity, "casadi_force")
-def _pmg_force(m: PointMassGravity, t: float, r_N: Any, v_N: Any, body: Body) -> Any:
-    ca = _ca()
-    rn2 = ca.sumsqr(r_N)
-    return (-m.mu * body.mass) * r_N / (rn2 * ca.sqrt(rn2))
-
-
-@register_casadi_form(PointMassGravity, "casadi_wrench")
-def _pmg_wrench(m: PointMassGravity, t: float, g_NB: Any, V_B: Any, body: Body) -> Any:
-    ca = _ca()
-    f = _pmg_force(m, t, g_NB[:3, 3], None, body)
-    return ca.vertcat(ca.DM.zeros(3, 1), g_NB[:3, :3].T @ f)
-
-
-@register_casadi_form(AppliedWrench, "casadi_force")
-def _aw_force(m: AppliedWrench, t: float, r_N: Any, v_N: Any, body: Body) -> Any:
-    return _column(m.force(t, np.zeros(3), np.zeros(3), body))  # a function of t only
-
-
-@register_casadi_form(AppliedWrench, "casadi_wrench")
-def _aw_wrench(m: AppliedWrench, t: float, g_NB: Any, V_B: Any, body: Body) -> Any:
-    ca = _ca()
-    w = _column(m._fun(t))
-    if m.frame == "inertial":
-        Rt = g_NB[:3, :3].T
-        return ca.vertcat(Rt @ w[:3], Rt @ w[3:])
-    return w
-
-
-@register_casadi_form(PlaneBound, "casadi_value")
-def _plane_value(c: PlaneBound, q: tuple[Any, ...], nu: tuple[Any, ...], t: float) -> Any:
-    qb = q[0]
-    r = qb[:3, 3] if qb.shape == (4, 4) else qb
-    return _column(c.normal).T @ r
-
-
-@register_casadi_form(TrackingErrorBound, "casadi_value")
-def _tracking_value(c: TrackingErrorBound, q: tuple[Any, ...], nu: tuple[Any, ...], t: Any) -> Any:
-    ca = _ca()
-    if not isinstance(t, (int, float, np.floating)):  # the reference is numeric in t
-        raise DefinitionError(f"TrackingErrorBound {c.name!r} needs a numeric time")
-    r_r, v_r, _ = c.reference_kinematics(float(t))
-    err = q[0] - _column(r_r) if c.quantity == "position" else nu[0] - _column(v_r)
-    bound = float(c.bound(float(t))[0])
-    if c.form == "norm":
-        return ca.norm_2(err) - bound
-    return 0.5 * (ca.sumsqr(err) - bound**2)
-
-
-def _spring_point(q: Any, nu: Any, body: Body, p_B: Any) -> tuple[Any, Any]:
-    """World position and velocity of a body point (as SpringDamper._point)."""
-    ca = _ca()
-    if body.kind is BodyKind.RIGID:
-        R, p = q[:3, :3], _column(p_B)
-        return q[:3, 3] + R @ p, R @ (nu[3:] + ca.cross(nu[:3], p))
-    return q, nu
-
-
-def _spring_to_body(q: Any, body: Body, p_B: Any, f_N: Any) -> Any:
-    ca = _ca()
-    if body.kind is not BodyKind.RIGID:
-        return f_N
-    f_B = q[:3, :3].T @ f_N
-    return ca.vertcat(ca.cross(_column(p_B), f_B), f_B)
-
-
-@register_casadi_form(SpringDamper, "casadi_wrenches")
-def _spring_wrenches(
-    m: SpringDamper, t: Any, q: tuple[Any, ...], nu: tuple[Any, ...], bodies: tuple[Body, ...]
-) -> list[Any]:
-    ca = _ca()
-    x_a, v_a = _spring_point(q[0], nu[0], bodies[0], m.point_a)
-    if m.anchored:
-        x_b, v_b = _column(m.point_b), ca.DM.zeros(3, 1)
-    else:
-        x_b, v_b = _spring_point(q[1], nu[1], bodies[1], m.point_b)
-    d = x_b - x_a
-    length = ca.norm_2(d)
-    u = d / length
-    tension = m.k * (length - m.l0) + m.c * ca.dot(u, v_b - v_a)
-    f_a = tension * u
-    out = [_spring_to_body(q[0], bodies[0], m.point_a, f_a)]
-    if not m.anchored:
-        out.append(_spring_to_body(q[1], bodies[1], m.point_b, -f_a))
-    return out

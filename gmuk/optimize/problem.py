@@ -55,6 +55,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._casadi import casadi
 from gmuk._validation import FloatArray, as_array, check_se3, real_number
 from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.inequality import InequalityConstraint
@@ -140,7 +141,7 @@ class OptimalControlProblem:
     ) -> None:
         from gmuk.system import System
 
-        parts._ca()  # CasADi is installed, or a MissingDependencyError with the pip command
+        casadi()  # CasADi is installed, or a MissingDependencyError with the pip command
         if not isinstance(system, System):
             raise DefinitionError(f"system must be a gmuk.System; got {type(system).__name__}")
         if not isinstance(initial, State) or initial.layout != system.layout:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._forms import Forms
 from gmuk._validation import FloatArray
 from gmuk.control.base import Controller
 from gmuk.errors import DefinitionError
@@ -374,6 +375,11 @@ class OpenLoopControl(Controller):
     result : OptimalControlResult
     name : str
     """
+
+    _forms = Forms(
+        compiled="an interpolated table in Python: called back from the compiled loop",
+        symbolic="gmuk.optimize transcribes no controller (this is its output)",
+    )
 
     def __init__(self, result: OptimalControlResult, *, name: str = "optimal control") -> None:
         super().__init__(list(result.body_names), name=name)

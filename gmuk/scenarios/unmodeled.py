@@ -73,6 +73,7 @@ import numpy as np
 
 import gmuk
 from gmuk import plotting
+from gmuk._forms import Forms
 from gmuk._validation import FloatArray
 from gmuk.celestial import CelestialBody
 from gmuk.control import MorseLyapunovController
@@ -141,6 +142,12 @@ class HarmonicPerturbation(ForceModel):
     modeled : bool
         Default False: a disturbance the constraint solve does not know.
     """
+
+    _forms = Forms(
+        compiled="a scenario's disturbance (the field's degrees ≥ 2): called back from "
+        "the compiled loop",
+        symbolic="a disturbance of the simulations only; no CasADi form of a field",
+    )
 
     def __init__(
         self,

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import gmuk
+from gmuk.errors import DefinitionError
 from gmuk.lie import so3
 from gmuk.optimize import parts
 
@@ -106,3 +107,91 @@ def test_a_coupled_spring_is_transcribed_and_its_plan_re_simulates():
     driven = gmuk.System([a, b], forces=[spring], controllers=[result.controller()])
     traj = driven.simulate(state, (0.0, 3.0), t_eval=result.t, rtol=1e-11, atol=1e-12)
     np.testing.assert_allclose(traj.r_N, result.r_N, atol=1e-5)
+
+
+# --- forms declared on the class, and who inherits them (gmuk._forms) ---
+
+
+def _spring_case():
+    rng = np.random.default_rng(11)
+    bodies, state = _random_state(rng)
+    targets = [bodies[1], bodies[0]]  # a point mass and a rigid body
+    q, nu = _casadi_args(state, targets)
+    return state, targets, q, nu
+
+
+def test_a_subclass_that_keeps_the_physics_inherits_the_casadi_form():
+    class Renamed(gmuk.LinearSpringDamper):
+        def __init__(self, k, c):
+            super().__init__(k, c, anchor=[0.3, 0.0, -0.1], name="renamed")
+
+    state, targets, q, nu = _spring_case()
+    model = Renamed(2.0, 0.3)
+    symbolic = parts.force_terms(model, state.t, q, nu, targets)
+    for w_num, w_ca in zip(model.wrenches(state, targets), symbolic, strict=True):
+        np.testing.assert_allclose(np.asarray(ca.DM(w_ca)).ravel(), w_num, rtol=1e-13, atol=1e-12)
+
+
+def test_a_subclass_that_changes_the_physics_does_not_inherit_the_casadi_form():
+    class Stiffer(gmuk.LinearSpringDamper):
+        def force(self, t, r_N, v_N, body):
+            return 2.0 * super().force(t, r_N, v_N, body)
+
+    state, targets, q, nu = _spring_case()
+    with pytest.raises(DefinitionError, match=r"Stiffer overrides a numeric method of Linear"):
+        parts.force_terms(Stiffer(2.0, 0.3), state.t, q, nu, targets)
+
+    class StifferWithItsForm(Stiffer):
+        def casadi_force(self, t, r_N, v_N, body):
+            return 2.0 * gmuk.LinearSpringDamper.casadi_force(self, t, r_N, v_N, body)
+
+    model = StifferWithItsForm(2.0, 0.3)
+    (w_ca,) = parts.force_terms(model, state.t, q[:1], nu[:1], targets[:1])
+    (w_num,) = model.wrenches(state, targets[:1])
+    np.testing.assert_allclose(np.asarray(ca.DM(w_ca)).ravel(), w_num, rtol=1e-13)
+    # its wrench() is still the parent's, but the parent's casadi_wrench is not inherited:
+    # the class changed force(), and gmuk cannot tell which of the parent's forms still hold
+    with pytest.raises(DefinitionError, match="rigid body 'a'"):
+        parts.force_terms(model, state.t, q[1:], nu[1:], targets[1:])
+
+
+def test_an_inequality_that_changes_its_value_falls_back_to_the_generic_path():
+    class Shifted(gmuk.PlaneBound):
+        def value(self, q, nu, t):  # written with operations CasADi supports
+            n, r = self.normal, q[0][:3, 3]
+            return n[0] * r[0] + n[1] * r[1] + n[2] * r[2] + 1.0
+
+    rng = np.random.default_rng(5)
+    bodies, state = _random_state(rng)
+    bound = Shifted(bodies[0], [1.0, 2.0, -1.0], upper=10.0, name="shifted")
+    q, nu = _casadi_args(state, [bodies[0]])
+    num = bound.value((state.pose(bodies[0]),), (state.twist(bodies[0]),), state.t)
+    assert bound._declared_form("casadi_value") is None
+    assert float(parts.inequality_value(bound, q, nu, state.t)) == pytest.approx(num, rel=1e-14)
+
+
+def test_a_form_registered_for_a_users_class_is_found_for_that_class_only():
+    class Drag(gmuk.ForceModel):
+        def __init__(self, c):
+            super().__init__()
+            self.c = c
+
+        def force(self, t, r_N, v_N, body):
+            return -self.c * v_N
+
+    class HeavierDrag(Drag):
+        pass
+
+    @parts.register_casadi_form(Drag, "casadi_force")
+    def _drag(model, t, r_N, v_N, body):
+        return -model.c * v_N
+
+    state, targets, q, nu = _spring_case()
+    try:
+        (f_ca,) = parts.force_terms(Drag(0.7), state.t, q[:1], nu[:1], targets[:1])
+        (f_num,) = Drag(0.7).wrenches(state, targets[:1])
+        np.testing.assert_allclose(np.asarray(ca.DM(f_ca)).ravel(), f_num, rtol=1e-15)
+        with pytest.raises(DefinitionError, match="HeavierDrag"):
+            parts.force_terms(HeavierDrag(0.7), state.t, q[:1], nu[:1], targets[:1])
+    finally:
+        del parts._FORMS[(Drag, "casadi_force")]
