@@ -58,6 +58,17 @@ Departures from McCann (2020), Eq. 81 (errata, "Section 5.1 controller")
 The printed law is kept as ``variant="thesis"`` (with its k₃ = 1000) for reproducing the
 thesis and showing its divergence.
 
+One definition
+--------------
+The corrected law is written once, as numba kernels in this module:
+:func:`morse_lyapunov_errors` (E_R, q, E_V, Ad_{E_g⁻¹} V_n, s, ψ), :func:`morse_lyapunov_law`
+(u and ż from them, for any nominal motion) and :func:`morse_lyapunov_lvlh` (the law on an
+:class:`~gmuk.orbits.LVLHReference`, the nominal evaluated in the kernel). The Python methods
+(:meth:`MorseLyapunovController.control`, :meth:`~MorseLyapunovController.errors`,
+:func:`morse_s`, :func:`morse_s_rate_matrix`) call them, and so does the compiled step loop
+(:func:`gmuk.control._kernels.apply_control`); the printed law reuses :func:`morse_s` and Eq.
+90's bound.
+
 References
 ----------
 McCann (2020), Eqs. (81)–(90); Nazari, Maadani, Butcher & Yucelen (2018), "Morse–Lyapunov-
@@ -73,22 +84,192 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._forms import Forms
+from gmuk._numba import njit
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind, RigidBody
 from gmuk.control.base import Controller
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3, so3
+from gmuk.lie._kernels import _ad_apply, _cross
+from gmuk.orbits._kernels import lvlh_state
 from gmuk.reference import ReferenceTrajectory
 
 if TYPE_CHECKING:
     from gmuk.state import State
     from gmuk.trajectory import Trajectory
 
-__all__ = ["MorseLyapunovController", "TrackingErrors", "morse_s", "morse_s_rate_matrix"]
+__all__ = [
+    "N_LAW_PARAMS",
+    "MorseLyapunovController",
+    "TrackingErrors",
+    "morse_lyapunov_errors",
+    "morse_lyapunov_law",
+    "morse_lyapunov_lvlh",
+    "morse_s",
+    "morse_s_rate_matrix",
+]
 
-_EYE3 = np.eye(3)
 #: Eq. 90's printed robust gain κ₂ (with its O/‖r‖⁴ bound).
 KAPPA2_THESIS = -39.0 / 2.0
+
+#: Parameters of :func:`morse_lyapunov_law`: [k11, k12, k21 (3), k22 (3), κ, a (3), k_I,
+#: robust, κ₂, 𝕀 (36, row-major)].
+N_LAW_PARAMS = 51
+#: Parameters of :func:`morse_lyapunov_lvlh`: the orbit [n, e, μ, p, R_NP (9, row-major)],
+#: then those of the law.
+N_LVLH_PARAMS = 13 + N_LAW_PARAMS
+
+
+# ---------------------------------------------------------------- the kernels: the law, once
+
+
+@njit(cache=True, inline="always")
+def _morse_s_into(E_R, a, s):  # type: ignore[no-untyped-def]
+    """Write s(E_R) of Eq. 84 into ``s`` (3,): row i of E_R is E_Rᵀ eᵢ, and
+    ``Σ aᵢ (E_Rᵀ eᵢ)^× eᵢ`` written out per component."""
+    s[0] = E_R[2, 1] * a[2] - E_R[1, 2] * a[1]
+    s[1] = E_R[0, 2] * a[0] - E_R[2, 0] * a[2]
+    s[2] = E_R[1, 0] * a[1] - E_R[0, 1] * a[0]
+
+
+@njit(cache=True, inline="always")
+def _morse_q_into(E_R, a, Q):  # type: ignore[no-untyped-def]
+    """Write ``Q = tr(A E_Rᵀ) I − E_Rᵀ A`` (ṡ = Q E_ω) into ``Q`` (3, 3)."""
+    tr = E_R[0, 0] * a[0] + E_R[1, 1] * a[1] + E_R[2, 2] * a[2]
+    for i in range(3):
+        for j in range(3):
+            Q[i, j] = -E_R[j, i] * a[j]
+        Q[i, i] += tr
+
+
+@njit(cache=True, inline="always")
+def _eq90_bound(g, kappa2):  # type: ignore[no-untyped-def]
+    """Eq. 90's bound ``κ₂/‖r‖⁴`` (each of the six components of κ₂ O/‖r‖⁴) at pose g."""
+    r2 = g[0, 3] * g[0, 3] + g[1, 3] * g[1, 3] + g[2, 3] * g[2, 3]
+    return kappa2 / (r2 * r2)
+
+
+@njit(cache=True, inline="always")
+def _Ad_apply(R, p, V, out):  # type: ignore[no-untyped-def]
+    """out = Ad_(R, p) V = [R ω; p × (R ω) + R v] for V = [ω; v]."""
+    w0 = R[0, 0] * V[0] + R[0, 1] * V[1] + R[0, 2] * V[2]
+    w1 = R[1, 0] * V[0] + R[1, 1] * V[1] + R[1, 2] * V[2]
+    w2 = R[2, 0] * V[0] + R[2, 1] * V[1] + R[2, 2] * V[2]
+    c0, c1, c2 = _cross(p[0], p[1], p[2], w0, w1, w2)
+    out[0], out[1], out[2] = w0, w1, w2
+    out[3] = c0 + R[0, 0] * V[3] + R[0, 1] * V[4] + R[0, 2] * V[5]
+    out[4] = c1 + R[1, 0] * V[3] + R[1, 1] * V[4] + R[1, 2] * V[5]
+    out[5] = c2 + R[2, 0] * V[3] + R[2, 1] * V[4] + R[2, 2] * V[5]
+
+
+@njit(cache=True)
+def morse_lyapunov_errors(g, V, gn, Vn, a, k11, k12, E_R, q, E_V, Vn_B, s, psi):  # type: ignore[no-untyped-def]
+    """The corrected law's errors of pose g (4, 4) and twist V (6,) against the nominal
+    (gn, Vn), written into E_R (3, 3), q (3,), E_V, Vn_B (6,), s (3,) and ψ (6,):
+
+    ``E_R = R_nᵀ R``, ``q = Rᵀ(r − r_n)``, ``Vn_B = Ad_{E_g⁻¹} V_n`` with
+    ``E_g⁻¹ = (E_Rᵀ, −q)``, ``E_V = V − Vn_B``, ``s = s(E_R)`` (Eq. 84) and
+    ``ψ = E_V + K₁ [s; q]`` (Eq. 82), ``K₁ = blkdiag(k₁₁ I₃, k₁₂ I₃)``.
+    """
+    for i in range(3):
+        for j in range(3):
+            E_R[i, j] = gn[0, i] * g[0, j] + gn[1, i] * g[1, j] + gn[2, i] * g[2, j]
+    d0, d1, d2 = g[0, 3] - gn[0, 3], g[1, 3] - gn[1, 3], g[2, 3] - gn[2, 3]
+    for i in range(3):
+        q[i] = g[0, i] * d0 + g[1, i] * d1 + g[2, i] * d2
+    Re = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            Re[i, j] = E_R[j, i]
+    pe = np.empty(3)
+    for i in range(3):
+        pe[i] = -q[i]
+    _Ad_apply(Re, pe, Vn, Vn_B)
+    for i in range(6):
+        E_V[i] = V[i] - Vn_B[i]
+    _morse_s_into(E_R, a, s)
+    for i in range(3):
+        psi[i] = E_V[i] + k11 * s[i]
+        psi[3 + i] = E_V[3 + i] + k12 * q[i]
+
+
+@njit(cache=True)
+def morse_lyapunov_law(g, V, a_model, z, gn, Vn, Vdn, p, u, psi):  # type: ignore[no-untyped-def]
+    """The corrected law (module docstring): the wrench ``u`` (6,) and ż = ψ (6,) for a body at
+    pose g, twist V, modeled acceleration ``a_model`` (6,) and internal state z (6,), tracking
+    the nominal (gn, Vn, Vdn); ``p`` as :data:`N_LAW_PARAMS` describes. With the errors of
+    :func:`morse_lyapunov_errors` and ``l̇ = [Q E_ω; E_v − E_ω × q]``,
+
+    ``V̇_cmd = Ad_{E_g⁻¹} V̇_n − ad_{E_V} Ad_{E_g⁻¹} V_n − K₁ l̇ − K₂ ψ − [0; κ q] − k_I z``
+    and ``u = 𝕀 (V̇_cmd − a_model)``, less ``𝕀 κ₂ O/‖r‖⁴`` (Eq. 90) when robust.
+    """
+    k11, k12 = p[0], p[1]
+    kappa = p[8]
+    a = p[9:12]
+    k_int, robust, kappa2 = p[12], p[13], p[14]
+    E_R = np.empty((3, 3))
+    q = np.empty(3)
+    E_V = np.empty(6)
+    Vn_B = np.empty(6)
+    s = np.empty(3)
+    morse_lyapunov_errors(g, V, gn, Vn, a, k11, k12, E_R, q, E_V, Vn_B, s, psi)
+    Re = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            Re[i, j] = E_R[j, i]
+    pe = np.empty(3)
+    for i in range(3):
+        pe[i] = -q[i]
+    Vdn_B = np.empty(6)
+    _Ad_apply(Re, pe, Vdn, Vdn_B)
+    Q = np.empty((3, 3))
+    _morse_q_into(E_R, a, Q)
+    l_dot = np.empty(6)
+    for i in range(3):
+        l_dot[i] = Q[i, 0] * E_V[0] + Q[i, 1] * E_V[1] + Q[i, 2] * E_V[2]
+    c0, c1, c2 = _cross(E_V[0], E_V[1], E_V[2], q[0], q[1], q[2])
+    l_dot[3] = E_V[3] - c0
+    l_dot[4] = E_V[4] - c1
+    l_dot[5] = E_V[5] - c2
+    ad = np.empty(6)
+    _ad_apply(E_V, Vn_B, ad)
+    dv = np.empty(6)
+    for i in range(6):
+        k1 = k11 if i < 3 else k12
+        dv[i] = Vdn_B[i] - ad[i] - k1 * l_dot[i] - p[2 + i] * psi[i] - k_int * z[i] - a_model[i]
+    for i in range(3):
+        dv[3 + i] -= kappa * q[i]
+    if robust != 0.0:
+        bound = _eq90_bound(g, kappa2)
+        for i in range(6):
+            dv[i] -= bound
+    for i in range(6):
+        acc = 0.0
+        for j in range(6):
+            acc += p[15 + 6 * i + j] * dv[j]
+        u[i] = acc
+
+
+@njit(cache=True)
+def morse_lyapunov_lvlh(t, g, V, a_model, z, p, u, psi):  # type: ignore[no-untyped-def]
+    """:func:`morse_lyapunov_law` tracking an :class:`~gmuk.orbits.LVLHReference`, its nominal
+    at time t evaluated here (:func:`gmuk.orbits._kernels.lvlh_state`); ``p`` as
+    :data:`N_LVLH_PARAMS` describes."""
+    R_NP = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            R_NP[i, j] = p[4 + 3 * i + j]
+    gn = np.empty((4, 4))
+    Vn = np.empty(6)
+    Vdn = np.empty(6)
+    lvlh_state(t, p[0], p[1], p[2], p[3], R_NP, gn, Vn, Vdn)
+    morse_lyapunov_law(g, V, a_model, z, gn, Vn, Vdn, p[13:], u, psi)
+
+
+def _f64(x: Any) -> FloatArray:
+    """A fresh C-contiguous float64 array (what the kernels are compiled for)."""
+    return np.array(x, dtype=np.float64)
 
 
 def morse_s(E_R: FloatArray, a: FloatArray) -> FloatArray:
@@ -104,9 +285,9 @@ def morse_s(E_R: FloatArray, a: FloatArray) -> FloatArray:
     a : ndarray (3,)
         Morse weights, the diagonal of A (dimensionless, distinct and > 0).
     """
-    # (E_Rᵀ eᵢ) is row i of E_R; Σ aᵢ uᵢ × eᵢ written out per component
-    u = E_R * a[:, None]
-    return np.array([u[2, 1] - u[1, 2], u[0, 2] - u[2, 0], u[1, 0] - u[0, 1]])
+    out = np.empty(3)
+    _morse_s_into(_f64(E_R), _f64(a), out)
+    return out
 
 
 def morse_s_rate_matrix(E_R: FloatArray, a: FloatArray) -> FloatArray:
@@ -120,8 +301,9 @@ def morse_s_rate_matrix(E_R: FloatArray, a: FloatArray) -> FloatArray:
     a : ndarray (3,)
         Morse weights, the diagonal of A (dimensionless).
     """
-    AEt = E_R.T * a[None, :]  # E_Rᵀ A
-    return float(np.trace(AEt)) * _EYE3 - AEt
+    Q = np.empty((3, 3))
+    _morse_q_into(_f64(E_R), _f64(a), Q)
+    return Q
 
 
 @dataclass(frozen=True)
@@ -241,6 +423,8 @@ class MorseLyapunovController(Controller):
 
     uses_modeled_acceleration = True
     body_kinds = frozenset({BodyKind.RIGID})
+    _numeric_methods = ("control", "_errors")
+    _forms = Forms(compiled=True, symbolic="gmuk.optimize transcribes no controller")
 
     def __init__(
         self,
@@ -324,86 +508,74 @@ class MorseLyapunovController(Controller):
     def _errors(
         self, g: FloatArray, V: FloatArray, g_n: FloatArray, V_n: FloatArray
     ) -> TrackingErrors:
-        R, R_n = g[:3, :3], g_n[:3, :3]
-        E_R = R_n.T @ R
-        dr = g[:3, 3] - g_n[:3, 3]
-        q = R.T @ dr
-        E_g_inv = se3._inverse(se3._inverse(g_n) @ g)
-        Ad_inv = se3._Ad(E_g_inv)
-        Vn_B = Ad_inv @ V_n
-        E_V = V - Vn_B
-        s = morse_s(E_R, self.a)
-        psi = E_V + self._K1 * np.concatenate([s, q])
-        return TrackingErrors(E_R, q, E_V, Vn_B, Ad_inv, s, psi)
+        E_R, q, s = np.empty((3, 3)), np.empty(3), np.empty(3)
+        E_V, Vn_B, psi = np.empty(6), np.empty(6), np.empty(6)
+        morse_lyapunov_errors(
+            _f64(g), _f64(V), _f64(g_n), _f64(V_n), _f64(self.a), self.k11, self.k12,
+            E_R, q, E_V, Vn_B, s, psi,
+        )  # fmt: skip
+        E_g_inv = np.eye(4)
+        E_g_inv[:3, :3] = E_R.T
+        E_g_inv[:3, 3] = -q
+        return TrackingErrors(E_R, q, E_V, Vn_B, se3._Ad(E_g_inv), s, psi)
 
     # ------------------------------------------------------------------ the law
     def control(
         self, state: State, z: FloatArray, *modeled: FloatArray
     ) -> tuple[list[FloatArray], FloatArray]:
-        """The wrench [u_L; u_f] (body frame, N·m, N) and ż = ψ."""
+        """The wrench [u_L; u_f] (body frame, N·m, N) and ż = ψ
+        (:func:`morse_lyapunov_law`, or the printed law for ``variant="thesis"``)."""
         (body,) = self.bodies
         slot = state.layout.slot(body)
-        g, V = state.g[slot.index], state.V[slot.index]
-        I = self._I
-        a_model = modeled[0][slot.offset : slot.offset + 6]
+        g, V = _f64(state.g[slot.index]), _f64(state.V[slot.index])
+        a_model = _f64(modeled[0][slot.offset : slot.offset + 6])
         ref = self.reference.evaluate(state.t)
-        g_n = np.asarray(ref.g, dtype=float)
-        V_n = np.asarray(ref.V, dtype=float)
-        Vd_n = np.asarray(ref.V_dot, dtype=float)
+        g_n, V_n, Vd_n = _f64(ref.g), _f64(ref.V), _f64(ref.V_dot)
         if self.variant == "thesis":
-            u, psi = self._thesis_law(g, V, g_n, V_n, Vd_n, z, I)
-        else:
-            e = self._errors(g, V, g_n, V_n)
-            E_w, E_v = e.E_V[:3], e.E_V[3:]
-            l_dot = np.concatenate(
-                [morse_s_rate_matrix(e.E_R, self.a) @ E_w, E_v - so3._cross(E_w, e.q)]
-            )
-            coupling = np.concatenate([np.zeros(3), self.kappa * e.q])
-            V_dot_cmd = (
-                e.Ad_inv @ Vd_n
-                - se3._ad(e.E_V) @ e.Vn_B
-                - self._K1 * l_dot
-                - self._K2 * e.psi
-                - coupling
-                - self.k_integral * z
-            )
-            u = I @ (V_dot_cmd - a_model)
-            psi = e.psi
-        if self.robust:
-            u = u - I @ self._robust_bound(state.t, g, V)
+            u, psi = self._thesis_law(g, V, g_n, V_n, Vd_n, z, self._I)
+            if self.robust:
+                u = u - self._I @ self._robust_bound(state.t, g, V)
+            return [u], psi
+        u, psi = np.empty(6), np.empty(6)
+        morse_lyapunov_law(g, V, a_model, _f64(z), g_n, V_n, Vd_n, self._law_params(), u, psi)
+        if self.bound is not None:
+            u = u - self._I @ self._robust_bound(state.t, g, V)
         return [u], psi
 
+    def _law_params(self) -> FloatArray:
+        """The parameters of :func:`morse_lyapunov_law` (:data:`N_LAW_PARAMS`); Eq. 90's bound
+        is left to the kernel unless the user gave one (then :meth:`control` subtracts it)."""
+        robust = self.robust and self.bound is None
+        return np.concatenate(
+            [
+                [self.k11, self.k12],
+                self.k21,
+                self.k22,
+                [self.kappa],
+                self.a,
+                [self.k_integral, float(robust), self.kappa2],
+                np.ravel(self._I),
+            ]
+        ).astype(float)
+
     def _compiled_term(self) -> tuple[int, FloatArray] | None:
-        """How the compiled step loop evaluates this law (gmuk.control._kernels): the code
-        and the packed parameters, or None (the thesis variant, a user's bound, a reference
-        other than an LVLHReference, an overridden method) when it is called in Python."""
+        """How the compiled step loop evaluates this law (:func:`morse_lyapunov_lvlh` through
+        gmuk.control._kernels): the code and the packed parameters (:data:`N_LVLH_PARAMS`), or
+        None (the thesis variant, a user's bound, a reference other than an LVLHReference, an
+        overridden ``control``) when it is called in Python."""
         from gmuk.control import _kernels
         from gmuk.orbits.lvlh import LVLHReference
 
-        cls = MorseLyapunovController
         if (
-            type(self).control is not cls.control
-            or type(self)._errors is not cls._errors
+            not self._methods_are(MorseLyapunovController)
             or type(self.reference) is not LVLHReference
             or self.variant != "corrected"
             or self.bound is not None
         ):
             return None
         o = self.reference.orbit
-        params = np.concatenate(
-            [
-                [o.mean_motion, o.e, o.mu, o.p],
-                np.ravel(self.reference._R_NP),
-                [self.k11, self.k12],
-                self.k21,
-                self.k22,
-                [self.kappa],
-                self.a,
-                [self.k_integral, float(self.robust), self.kappa2],
-                np.ravel(self._I),
-            ]
-        ).astype(float)
-        assert params.size == _kernels.N_PARAMS
+        orbit = [o.mean_motion, o.e, o.mu, o.p, *np.ravel(self.reference._R_NP)]
+        params = np.concatenate([orbit, self._law_params()]).astype(float)
         return _kernels.MORSE_LYAPUNOV_LVLH, params
 
     def _robust_bound(self, t: float, g: FloatArray, V: FloatArray) -> FloatArray:
@@ -416,8 +588,7 @@ class MorseLyapunovController(Controller):
                     f"got shape {b.shape}"
                 )
             return b
-        r = g[:3, 3]
-        return np.full(6, self.kappa2 / float(r @ r) ** 2)
+        return np.full(6, _eq90_bound(_f64(g), self.kappa2))
 
     def _thesis_law(
         self,
