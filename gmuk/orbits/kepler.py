@@ -1,5 +1,10 @@
 """Kepler's equation and the anomalies of the three conics, as vectorised functions.
 
+Each solver is written once, as a compiled scalar function (``eccentric_from_mean_scalar``
+…, which the compiled reference kernels call at every integrator stage); the vectorised
+functions check and broadcast their input and apply the same scalar functions to every
+element.
+
 Three "mean anomalies" are linear in the time ``t`` since periapsis passage:
 
 =========  ======================  =============  =======================================
@@ -154,52 +159,14 @@ def wrap_to_pi(angle: Any) -> FloatArray:
     return np.where(a > np.pi, a - _TWO_PI, a)
 
 
-def _reduce(M: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Split ``M = M_r + 2πk`` with ``M_r ∈ [−π, π]`` (to rounding) and integer-valued k."""
-    k = np.round(M / _TWO_PI)
-    big = np.abs(k) >= _MAX_REVS
-    Mr = ((M - k * _C1) - k * _C2) - k * _C3
-    if big.any():  # beyond 2²⁶ revolutions a plain remainder is as good as anything
-        Mr = np.where(big, np.remainder(M + np.pi, _TWO_PI) - np.pi, Mr)
-        k = np.where(big, (M - Mr) / _TWO_PI, k)
-    return Mr, k
-
-
-def _unreduce(Er: FloatArray, k: FloatArray) -> FloatArray:
-    """``E_r + 2πk`` with the three-part 2π (exact except for the final rounding)."""
-    return ((Er + k * _C3) + k * _C2) + k * _C1
-
-
 def _x_minus_sin(x: FloatArray) -> FloatArray:
-    """``x − sin x`` without cancellation (Taylor series for |x| < 1)."""
-    x2 = x * x
-    # x³ Σ (−1)ᵏ x²ᵏ / (2k+3)!, k = 0..8: truncation < 1e-19 relative for |x| < 1.
-    s = np.full_like(x, 1.0 / 121645100408832000.0)  # 1/19!
-    for d in _XMS_DEN:  # 17!, 15!, ..., 3!
-        s = 1.0 / d - x2 * s
-    series = x * x2 * s
-    return np.where(np.abs(x) < 1.0, series, x - np.sin(x))
+    """``x − sin x`` without cancellation, elementwise (:func:`_x_minus_sin_scalar`)."""
+    return _each(_X_MINUS_SIN, x)
 
 
 def _sinh_minus_x(x: FloatArray) -> FloatArray:
-    """``sinh x − x`` without cancellation (Taylor series for |x| < 1)."""
-    x2 = x * x
-    s = np.full_like(x, 1.0 / 121645100408832000.0)
-    for d in _XMS_DEN:
-        s = 1.0 / d + x2 * s
-    series = x * x2 * s
-    with np.errstate(over="ignore"):
-        direct = np.sinh(x) - x
-    return np.where(np.abs(x) < 1.0, series, direct)
-
-
-def _cubic_root(c1: FloatArray, c3: FloatArray, x: FloatArray) -> FloatArray:
-    """The real root of ``c1 y + c3 y³ = x`` (c1 > 0, c3 > 0, x ≥ 0), in a stable form.
-
-    ``y = 2√(c1/(3c3)) sinh(asinh((3x/(2c1))·√(3c3/c1)) / 3)`` (Cardano, trigonometric form).
-    """
-    q = np.sqrt(c1 / (3.0 * c3))
-    return 2.0 * q * np.sinh(np.arcsinh(x / (2.0 * c1 * q)) / 3.0)
+    """``sinh x − x`` without cancellation, elementwise (:func:`_sinh_minus_x_scalar`)."""
+    return _each(_SINH_MINUS_X, x)
 
 
 def mean_from_eccentric(E: Any, e: Any) -> FloatArray:
@@ -264,41 +231,7 @@ def eccentric_from_mean(M: Any, e: Any) -> FloatArray:
     ----------
     McCann (2020), Eq. (77); Vallado (2013), Algorithm 2; Battin (1999), Ch. 5.
     """
-    M = _angle(M, "M")
-    e = _check_elliptic_e(e)
-    M, e = np.broadcast_arrays(M, e)
-    shape = M.shape
-    M, e = M.ravel(), e.ravel()
-    Mr, k = _reduce(M)
-    x = np.abs(Mr)
-    one_m_e = 1.0 - e
-    # Lower bound: (E − e sin E) ≤ (1 − e)E + (e/6)E³. Where e is tiny the cubic term is
-    # negligible and x itself is the start.
-    E = x.copy()
-    cubic = e > 1e-8
-    E[cubic] = _cubic_root(one_m_e[cubic], e[cubic] / 6.0, x[cubic])
-    upper = np.minimum(x + e, np.pi)
-    E = np.minimum(E, upper)
-    active = np.ones(E.shape, dtype=bool)
-    for _ in range(_MAX_ITER):
-        Ea = E[active]
-        ea, xa, oa = e[active], x[active], one_m_e[active]
-        s = np.sin(Ea)
-        resid = _x_minus_sin(Ea) + oa * s - xa
-        deriv = oa + 2.0 * ea * np.sin(0.5 * Ea) ** 2
-        step = resid / deriv
-        Enew = np.minimum(Ea - step, upper[active])
-        Enew = np.maximum(Enew, 0.0)
-        E[active] = Enew
-        # Newton's error after this step: ≈ (f''/2f') step² + (f'''/6f') |step|³.
-        a_step = np.abs(step)
-        still = 0.5 * ea * (np.abs(s) + a_step / 3.0) * a_step**2 > _STOP * deriv * Enew
-        idx = np.flatnonzero(active)
-        active[idx[~still]] = False
-        if not active.any():
-            break
-    Er = np.copysign(E, Mr)
-    return _unreduce(Er, k).reshape(shape)
+    return _each(_ECCENTRIC_FROM_MEAN, _angle(M, "M"), _check_elliptic_e(e))
 
 
 def _same_revolution(wrapped: FloatArray, ref: FloatArray) -> FloatArray:
@@ -330,12 +263,7 @@ def true_from_eccentric(E: Any, e: Any) -> FloatArray:
     ----------
     McCann (2020), Eq. (78); Vallado (2013), Ch. 2; Battin (1999), Ch. 4.
     """
-    E = _angle(E, "E")
-    e = _check_elliptic_e(e)
-    wrapped = np.arctan2(
-        np.sqrt((1.0 - e) * (1.0 + e)) * np.sin(E), (1.0 - e) - 2.0 * np.sin(0.5 * E) ** 2
-    )
-    return _same_revolution(wrapped, E)
+    return _each(_TRUE_FROM_ECCENTRIC, _angle(E, "E"), _check_elliptic_e(e))[()]
 
 
 def eccentric_from_true(f: Any, e: Any) -> FloatArray:
@@ -461,14 +389,7 @@ def parabolic_from_mean(M_p: Any) -> FloatArray:
     ----------
     Vallado (2013), Ch. 2 (Barker's equation) and Algorithm 3.
     """
-    M = as_array(M_p, (), "M_p")
-    x = np.abs(M)
-    s = np.cbrt(0.5 * (3.0 * x + np.hypot(3.0 * x, 2.0)))
-    D = 3.0 * x / (s * s + 1.0 + 1.0 / (s * s))
-    with np.errstate(over="ignore", invalid="ignore"):
-        polished = D - (D + D**3 / 3.0 - x) / (1.0 + D * D)
-    D = np.where(np.isfinite(polished), polished, D)
-    return np.copysign(D, M)
+    return _each(_PARABOLIC_FROM_MEAN, as_array(M_p, (), "M_p"))[()]
 
 
 def true_from_parabolic(D: Any) -> FloatArray:
@@ -570,35 +491,7 @@ def hyperbolic_from_mean(M_h: Any, e: Any) -> FloatArray:
     ----------
     Vallado (2013), Algorithm 4; Battin (1999), Ch. 4.
     """
-    M = as_array(M_h, (), "M_h")
-    e = _check_hyperbolic_e(e)
-    M, e = np.broadcast_arrays(M, e)
-    shape = M.shape
-    M, e = M.ravel(), e.ravel()
-    x = np.abs(M)
-    em1 = e - 1.0
-    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        H = np.minimum(np.arcsinh(x / em1), _cubic_root(em1, e / 6.0, x))
-    for _ in range(2):
-        H = np.arcsinh((x + H) / e)
-    H = np.array(H, dtype=np.float64)
-    active = np.ones(H.shape, dtype=bool)
-    for _ in range(_MAX_ITER):
-        Ha = H[active]
-        ea, xa, em1a = e[active], x[active], em1[active]
-        resid = em1a * np.sinh(Ha) + _sinh_minus_x(Ha) - xa
-        deriv = em1a + 2.0 * ea * np.sinh(0.5 * Ha) ** 2
-        step = resid / deriv
-        Hnew = np.maximum(Ha - step, 0.0)
-        H[active] = Hnew
-        a_step = np.abs(step)
-        curv = np.abs(np.sinh(Ha)) + np.cosh(Ha) * a_step / 3.0
-        still = 0.5 * ea * curv * a_step**2 > _STOP * deriv * Hnew
-        idx = np.flatnonzero(active)
-        active[idx[~still]] = False
-        if not active.any():
-            break
-    return np.copysign(H, M).reshape(shape)
+    return _each(_HYPERBOLIC_FROM_MEAN, as_array(M_h, (), "M_h"), _check_hyperbolic_e(e))
 
 
 def true_from_hyperbolic(H: Any, e: Any) -> FloatArray:
@@ -620,9 +513,7 @@ def true_from_hyperbolic(H: Any, e: Any) -> FloatArray:
     ----------
     Vallado (2013), Ch. 2; Battin (1999), Ch. 4.
     """
-    H = as_array(H, (), "H")
-    e = _check_hyperbolic_e(e)
-    return 2.0 * np.arctan(np.sqrt((e + 1.0) / (e - 1.0)) * np.tanh(0.5 * H))
+    return _each(_TRUE_FROM_HYPERBOLIC, as_array(H, (), "H"), _check_hyperbolic_e(e))[()]
 
 
 def hyperbolic_from_true(f: Any, e: Any) -> FloatArray:
@@ -660,11 +551,20 @@ def hyperbolic_from_true(f: Any, e: Any) -> FloatArray:
     return 2.0 * np.arctanh(np.sqrt((e - 1.0) / (e + 1.0)) * np.tan(0.5 * f))
 
 
-# ---------------------------------------------------------------- scalar fast paths
-# The same algorithms on floats (no validation, no arrays), compiled: a reference trajectory
-# is evaluated at every integrator stage, where numpy's per-call overhead would dominate, and
-# compiled reference kernels call them. Callers validate e once; tests check these agree with
-# the vectorised functions. Pass floats (an int argument compiles a second version).
+# ---------------------------------------------------------------- the scalar definitions
+# The algorithms on floats (no validation, no arrays), compiled: the one definition of each.
+# The compiled reference kernels call them at every integrator stage; the vectorised
+# functions above apply them to every element (:func:`_each`). Callers validate e once. Pass
+# floats (an int argument compiles a second version).
+
+
+@njit(cache=True)
+def _round(x: float) -> float:
+    """x rounded to the nearest integer (halves to even), as a float; no integer overflow:
+    beyond 2⁵² every float is an integer already."""
+    if abs(x) < 4503599627370496.0:
+        return float(round(x))
+    return x
 
 
 @njit(cache=True)
@@ -698,7 +598,7 @@ def _cubic_root_scalar(c1: float, c3: float, x: float) -> float:
 @njit(cache=True)
 def eccentric_from_mean_scalar(M: float, e: float) -> float:
     """:func:`eccentric_from_mean` for one finite float M and ``0 ≤ e < 1`` (not checked)."""
-    k = float(round(M / _TWO_PI))
+    k = _round(M / _TWO_PI)
     if abs(k) < _MAX_REVS:
         Mr = ((M - k * _C1) - k * _C2) - k * _C3
     else:  # beyond 2²⁶ revolutions a plain remainder is as good as anything (as _reduce)
@@ -728,7 +628,7 @@ def true_from_eccentric_scalar(E: float, e: float) -> float:
     w = math.atan2(
         math.sqrt((1.0 - e) * (1.0 + e)) * math.sin(E), (1.0 - e) - 2.0 * math.sin(0.5 * E) ** 2
     )
-    return w + _TWO_PI * round((E - w) / _TWO_PI)
+    return w + _TWO_PI * _round((E - w) / _TWO_PI)
 
 
 @njit(cache=True)
@@ -761,8 +661,53 @@ def true_from_hyperbolic_scalar(H: float, e: float) -> float:
 def parabolic_from_mean_scalar(M_p: float) -> float:
     """:func:`parabolic_from_mean` for one finite float."""
     x = abs(M_p)
-    s = (0.5 * (3.0 * x + math.hypot(3.0 * x, 2.0))) ** (1.0 / 3.0)
+    s = np.cbrt(0.5 * (3.0 * x + math.hypot(3.0 * x, 2.0)))
     D = 3.0 * x / (s * s + 1.0 + 1.0 / (s * s))
-    if D < 1e100:
-        D -= (D + D**3 / 3.0 - x) / (1.0 + D * D)
+    polished = D - (D + D**3 / 3.0 - x) / (1.0 + D * D)  # not finite past D ~ 5e102
+    if math.isfinite(polished):
+        D = polished
     return math.copysign(D, M_p)
+
+
+# codes of the scalar functions for :func:`_each_into`
+_ECCENTRIC_FROM_MEAN = 0
+_TRUE_FROM_ECCENTRIC = 1
+_HYPERBOLIC_FROM_MEAN = 2
+_TRUE_FROM_HYPERBOLIC = 3
+_PARABOLIC_FROM_MEAN = 4
+_X_MINUS_SIN = 5
+_SINH_MINUS_X = 6
+
+
+@njit(cache=True)
+def _each_into(which, x, y, out):  # type: ignore[no-untyped-def]
+    """``out[i] = f(x[i], y[i])`` (or ``f(x[i])``) for the scalar function ``which``."""
+    for i in range(x.size):
+        if which == _ECCENTRIC_FROM_MEAN:
+            out[i] = eccentric_from_mean_scalar(x[i], y[i])
+        elif which == _TRUE_FROM_ECCENTRIC:
+            out[i] = true_from_eccentric_scalar(x[i], y[i])
+        elif which == _HYPERBOLIC_FROM_MEAN:
+            out[i] = hyperbolic_from_mean_scalar(x[i], y[i])
+        elif which == _TRUE_FROM_HYPERBOLIC:
+            out[i] = true_from_hyperbolic_scalar(x[i], y[i])
+        elif which == _PARABOLIC_FROM_MEAN:
+            out[i] = parabolic_from_mean_scalar(x[i])
+        elif which == _X_MINUS_SIN:
+            out[i] = _x_minus_sin_scalar(x[i])
+        else:
+            out[i] = _sinh_minus_x_scalar(x[i])
+
+
+def _each(which: int, x: FloatArray, y: FloatArray | None = None) -> FloatArray:
+    """A scalar function applied to every element of x (and y, broadcast against x): an array
+    of the broadcast shape (0-d for scalars)."""
+    if y is None:
+        xb, yb = x, x
+    else:
+        xb, yb = np.broadcast_arrays(x, y)
+    xs = np.ascontiguousarray(xb, dtype=np.float64).ravel()
+    ys = np.ascontiguousarray(yb, dtype=np.float64).ravel()
+    out = np.empty(xs.size)
+    _each_into(which, xs, ys, out)
+    return out.reshape(np.shape(xb))
