@@ -18,13 +18,18 @@ from gmuk._forms import Forms
 from gmuk._validation import FloatArray
 from gmuk.errors import DefinitionError, DomainError
 from gmuk.forces.base import ForceModel
+from gmuk.forces.gravity import gravity_gradient_wrench, point_mass_load
 from gmuk.gravity.legendre import legendre_4pi
-from gmuk.lie import so3
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
 
 __all__ = ["THESIS_NORMALIZATIONS", "ThesisRadialHarmonicGravity"]
+
+# arguments of the point-mass kernel that a point mass does not have
+_NO_INERTIA = np.zeros((3, 3))
+_NO_FIELD = np.zeros(1)
+_NO_FIELD.setflags(write=False)
 
 #: Choices of P̄_np for :class:`ThesisRadialHarmonicGravity` (see its docstring).
 THESIS_NORMALIZATIONS = ("thesis_eq26c_intended", "thesis_eq26c", "4pi")
@@ -253,29 +258,39 @@ class ThesisRadialHarmonicGravity(ForceModel):
         return n, self.mu / (r2 * rn), r2, (n + 1.0) * rho_n * T[1:]
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
-        """The printed Eq. 25 force ``m a`` on a point mass, in N (N)."""
+        """The printed Eq. 25 force ``m a`` on a point mass, in N (N): the point-mass force
+        (:func:`~gmuk.forces.gravity.point_mass_load`) times ``1 − Σ (n+1) ρⁿ T_n``."""
         r = np.asarray(r_N, dtype=float)
-        _, mu_r3, _, c = self._radial_terms(t, r)
-        return (-mu_r3 * body.mass * (1.0 - float(np.sum(c)))) * r
+        _, _, _, c = self._radial_terms(t, r)
+        g = np.eye(4)
+        g[:3, 3] = r
+        central = np.empty(3)
+        point_mass_load(
+            False, float(t), g, np.zeros(6), float(body.mass), _NO_INERTIA,
+            np.array([self.mu]), _NO_FIELD, central,
+        )  # fmt: skip
+        return (1.0 - float(np.sum(c))) * central
 
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:
-        """[L; f] in the body frame (N·m, N) by Eqs. 59 and 42."""
+        """[L; f] in the body frame (N·m, N) by Eqs. 59 and 42: their central parts are Eq. 23
+        (:func:`~gmuk.forces.gravity.gravity_gradient_wrench`, GravityGradient's kernel), to
+        which the harmonic sums add."""
         m = body.mass
-        r_N = np.asarray(g_NB[:3, 3], dtype=float)
+        g = np.array(g_NB, dtype=float)
+        r_N = g[:3, 3].copy()
         n, mu_r3, r2, c = self._radial_terms(t, r_N)  # c = (n+1) ρⁿ T_n, n ≥ 1
-        rn = float(np.sqrt(r2))
-        J = body.inertia
-        r_B = g_NB[:3, :3].T @ r_N
+        J = np.array(body.inertia, dtype=float)
+        # Eq. 33 (= Eq. 23b in the body frame) and Eq. 52 (= Eq. 23a)
+        eq23 = np.empty(6)
+        gravity_gradient_wrench(g, self.mu, float(m), J, eq23)
+        r_B = g[:3, :3].T @ r_N
         Jr = J @ r_B
         trJ = float(np.trace(J))
         q = float(r_B @ Jr) / r2  # r̂ᵀ J r̂
-        # Eq. 33 (= Eq. 23b in the body frame)
-        f = (-mu_r3 * m) * (r_B + (3.0 / (m * r2)) * (Jr + 0.5 * (trJ - 5.0 * q) * r_B))
         # Eq. 42, second line: Σ μ m (n+1) ρⁿ T_n / |r|³ {r + (n+3)/(m r²)(J + (n+2)/4 [..] I) r}
         k = (n + 3.0) / (m * r2)
         scalar = float(np.sum(c * (1.0 + k * (n + 2.0) / 4.0 * (trJ - (n + 5.0) * q))))
-        f = f + (mu_r3 * m) * (scalar * r_B + float(np.sum(c * k)) * Jr)
-        # Eq. 59
+        f = eq23[3:] + (mu_r3 * m) * (scalar * r_B + float(np.sum(c * k)) * Jr)
+        # Eq. 59: Eq. 23a's torque 3μ/|r|⁵ r × J r times the printed bracket [3 − Σ ...]/3
         bracket = 3.0 - float(np.sum(c * (n + 3.0)))
-        L = (self.mu / (r2 * r2 * rn) * bracket) * so3._cross(r_B, Jr)
-        return np.concatenate([L, f])
+        return np.concatenate([eq23[:3] * (bracket / 3.0), f])
