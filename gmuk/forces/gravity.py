@@ -45,6 +45,7 @@ __all__ = [
     "GravityGradient",
     "PointMassGravity",
     "SphericalHarmonicGravity",
+    "field_wrench",
     "gravity_gradient_load",
     "gravity_gradient_wrench",
     "harmonic_point_load",
@@ -229,6 +230,31 @@ def harmonic_point_load(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no
     return 0
 
 
+def field_wrench(
+    a_F: FloatArray, H_F: FloatArray, R_FB: FloatArray, mass: float, J: FloatArray
+) -> FloatArray:
+    """The wrench [L; f] (N·m, N; body frame) of a gravity field on a rigid body, to first
+    order in its size: ``L = (J H_B − H_B J)^∨`` with ``H_B = R_FBᵀ H_F R_FB`` and
+    ``f = m R_FBᵀ a_F``.
+
+    Parameters
+    ----------
+    a_F : ndarray, shape (3,)
+        The field's acceleration ∇U at the centre of mass, in F (m/s²).
+    H_F : ndarray, shape (3, 3)
+        Its gradient tensor ∇∇U there, in F (1/s²).
+    R_FB : ndarray, shape (3, 3)
+        The body's attitude in F (body components → F components).
+    mass : float
+        m (kg).
+    J : ndarray, shape (3, 3)
+        Central inertia in the body frame (kg·m²).
+    """
+    H_B = R_FB.T @ H_F @ R_FB
+    JH = J @ H_B - H_B @ J
+    return np.concatenate([[JH[2, 1], JH[0, 2], JH[1, 0]], mass * (R_FB.T @ a_F)])
+
+
 class SphericalHarmonicGravity(ForceModel):
     """Gravity of a central body's spherical-harmonic field on bodies, to second order in size.
 
@@ -318,20 +344,16 @@ class SphericalHarmonicGravity(ForceModel):
         m = body.mass
         R_FN = self.central_body.rotation.R_FN(t)
         r_F = R_FN @ g_NB[:3, 3]
-        J = body.inertia
         R_FB = R_FN @ g_NB[:3, :3]  # body components → F components
         both = getattr(self.field, "acceleration_hessian", None)  # one pass if the field can
         if both is not None:
             a_F, H_F = both(r_F)
         else:
             a_F, H_F = self.field.acceleration(r_F), self.field.hessian(r_F)
-        H_B = R_FB.T @ H_F @ R_FB
-        JH = J @ H_B - H_B @ J
-        L = np.array([JH[2, 1], JH[0, 2], JH[1, 0]])
-        f_B = m * (R_FB.T @ a_F)
+        w = field_wrench(a_F, H_F, R_FB, m, body.inertia)
         if self.include_finite_size_force:
-            f_B = f_B + R_FB.T @ self._finite_size_F(r_F, R_FB, J)
-        return np.concatenate([L, f_B])
+            w[3:] += R_FB.T @ self._finite_size_F(r_F, R_FB, body.inertia)
+        return w
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
         """m R_FNᵀ ∇U(R_FN r_N), in N (N) (:func:`harmonic_point_load` where it applies)."""

@@ -79,6 +79,7 @@ from gmuk.celestial import CelestialBody
 from gmuk.control import MorseLyapunovController
 from gmuk.errors import DefinitionError
 from gmuk.forces import ForceModel
+from gmuk.forces.gravity import field_wrench
 from gmuk.gravity import SphericalHarmonicField
 from gmuk.orbits import LVLHReference, fcei_orbit
 from gmuk.scenarios import Option, Scenario, ScenarioResult, boolean, fccl, positive_float
@@ -195,10 +196,7 @@ class HarmonicPerturbation(ForceModel):
         r_F = R_FN @ g_NB[:3, 3]
         R_FB = R_FN @ g_NB[:3, :3]
         a_F, H_F = self.field.acceleration_hessian(r_F, central=False)
-        H_B = R_FB.T @ H_F @ R_FB
-        J = body.inertia
-        JH = J @ H_B - H_B @ J
-        return np.array([JH[2, 1], JH[0, 2], JH[1, 0], *(body.mass * (R_FB.T @ a_F))], dtype=float)
+        return field_wrench(a_F, H_F, R_FB, body.mass, body.inertia)
 
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
         """``m ∇U₂`` at r_N, in N (N)."""
