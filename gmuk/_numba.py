@@ -31,6 +31,15 @@ by a numba whose format differs) is not an error: :func:`njit` gives each cached
 cache that treats such a file as a miss, removes its index (a :class:`GmukWarning` names it)
 and compiles the kernel again, which writes a fresh one.
 
+Kernels that call kernels of other modules
+------------------------------------------
+numba checks a cached kernel against its own source file only, yet a kernel's compiled code
+contains every kernel it calls, from any module: the compiled step loop holds the force,
+constraint, controller and solve kernels. :func:`sources_key` is a digest of every gmuk source
+that defines a kernel; a cache whose recorded digest differs (a kernel edited anywhere, in a
+development install) has all of gmuk's kernel caches discarded before anything is loaded from
+it (:func:`discard_stale_caches`).
+
 Calling without the dispatcher
 ------------------------------
 numba's dispatcher resolves the types of a kernel's arguments on every call, which costs
@@ -44,6 +53,8 @@ kernel reads memory wrongly. Callers check that before taking such a path.
 from __future__ import annotations
 
 import functools
+import hashlib
+import importlib
 import inspect
 import os
 import sys
@@ -59,7 +70,19 @@ from numba.core.caching import FunctionCache
 
 from gmuk.errors import GmukWarning
 
-__all__ = ["LazyEntries", "cache_plan", "compiled_entry", "entry", "njit", "user_cache_dir"]
+__all__ = [
+    "LazyEntries",
+    "cache_plan",
+    "compiled_entry",
+    "discard_stale_caches",
+    "entry",
+    "njit",
+    "sources_key",
+    "user_cache_dir",
+]
+
+#: Every cached kernel made by :func:`njit` in this process.
+_CACHED: list[Any] = []
 
 #: numba's configuration module (its settings are attributes made at run time).
 _config: Any = numba.config
@@ -202,7 +225,53 @@ def _checked(dispatcher: Any) -> Any:
     """``dispatcher`` with its numba cache replaced by :class:`_CheckedCache`."""
     if type(getattr(dispatcher, "_cache", None)) is FunctionCache:
         dispatcher._cache.__class__ = _CheckedCache
+        _CACHED.append(dispatcher)
     return dispatcher
+
+
+def _kernel_sources() -> list[Path]:
+    """gmuk's source files that define numba kernels, in a fixed order."""
+    root = Path(__file__).resolve().parent
+    return sorted(p for p in root.rglob("*.py") if "njit(" in p.read_text(encoding="utf-8"))
+
+
+@functools.cache
+def sources_key() -> str:
+    """A digest of every gmuk source that defines a kernel, and of numba's version."""
+    root = Path(__file__).resolve().parent
+    digest = hashlib.sha256(numba.__version__.encode())
+    for path in _kernel_sources():
+        digest.update(str(path.relative_to(root)).encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def discard_stale_caches(key_file: Path) -> bool:
+    """Discard gmuk's kernel caches when ``key_file`` does not hold :func:`sources_key`, and
+    record the key. Returns whether caches were discarded.
+
+    Every module that defines kernels is imported first, so that every cache is known; each
+    kernel's cache index is removed (numba then compiles it again and writes a new one)."""
+    key = sources_key()
+    try:
+        if key_file.read_text(encoding="ascii") == key:
+            return False
+    except (OSError, UnicodeDecodeError):
+        pass
+    root = Path(__file__).resolve().parent
+    for path in _kernel_sources():
+        module = ".".join(("gmuk", *path.relative_to(root).with_suffix("").parts))
+        with _suppressed():
+            importlib.import_module(module)
+    for dispatcher in _CACHED:
+        index = getattr(getattr(dispatcher._cache, "_cache_file", None), "_index_path", None)
+        if index is not None:
+            with _suppressed():
+                os.unlink(index)
+    with _suppressed():
+        key_file.parent.mkdir(parents=True, exist_ok=True)
+        key_file.write_text(key, encoding="ascii")
+    return True
 
 
 def njit(*args: Any, **options: Any) -> Any:

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import gmuk
-from gmuk import integrate, runs, testing
+from gmuk import _numba, integrate, runs, testing
 from gmuk.errors import DefinitionError, SimulationError
 from gmuk.integrators import _compiled, get_method
 from gmuk.testing import reference_simulate
@@ -1012,3 +1012,36 @@ def test_the_same_inputs_give_the_same_bits_on_a_cold_and_a_warm_cache(tmp_path)
     for other in results[1:]:
         for key in ("t", "g_NB", "V_B", "acceleration"):
             assert results[0][key].tobytes() == other[key].tobytes(), key
+
+
+@pytest.mark.slow
+def test_a_cache_compiled_from_other_kernel_sources_is_discarded_and_rebuilt(tmp_path):
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    outputs = []
+    for name in ("first", "stale"):
+        out = tmp_path / f"{name}.npz"
+        proc = subprocess.run(
+            [sys.executable, "-c", _RUN_AND_SAVE, str(out)],
+            env=env, capture_output=True, text=True, check=True,
+        )  # fmt: skip
+        outputs.append((proc, np.load(out)))
+        (key,) = (tmp_path / "numba").rglob("gmuk-kernels.key")
+        assert key.read_text() == _numba.sources_key()
+        key.write_text("the digest of an edited kernel")  # as if a kernel had changed
+    (_, a), (stale, b) = outputs
+    assert "compiling the integrator loop" in stale.stderr  # not loaded from the old cache
+    for k in ("t", "g_NB", "V_B", "acceleration"):
+        assert a[k].tobytes() == b[k].tobytes()
+
+
+def test_the_loop_cache_is_stale_when_the_kernel_sources_differ(tmp_path, monkeypatch):
+    key = tmp_path / "gmuk-kernels.key"
+    monkeypatch.setattr(_compiled, "_key_path", lambda: key)
+    assert _compiled._cache_is_stale()  # no key yet
+    key.write_text(_numba.sources_key())
+    assert not _compiled._cache_is_stale()
+    key.write_text("another")
+    assert _compiled._cache_is_stale()
+    # every source that defines a kernel is in the digest
+    sources = {p.name for p in _numba._kernel_sources()}
+    assert {"_compiled.py", "_kernels.py", "gravity.py", "_uk_kernels.py"} <= sources
