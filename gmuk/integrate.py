@@ -699,8 +699,9 @@ class _Loop:
         except Exception as exc:  # the model's own description
             return exc
         return _LoopFailure(
-            f"a compiled force model failed (kernel status {code}) at t = {t_bad:.9g} s: "
-            "the field has no finite value at a stage of the step (inside its body?)"
+            f"a compiled part's kernel failed (status {code}) at t = {t_bad:.9g} s; its Python "
+            "form raised nothing there (a field evaluated inside its body, or a kernel the "
+            "loop does not know?)"
         )
 
     @staticmethod

@@ -9,7 +9,8 @@ none) and have a factory of random valid instances here. Then, at 100 random sta
 * a declared compiled form exists for the case and gives the Python numbers: force models
   through ``gmuk.forces._kernels.apply_term`` with the code and parameters of
   ``_compiled_term`` (arguments laid out as the compiled loop lays them out), controllers
-  through ``gmuk.control._kernels.apply_control``;
+  through ``gmuk.control._kernels.apply_control``, constraints' rows through
+  ``gmuk.constraints._kernels.apply_rows``;
 * a declared symbolic form exists and gives the Python numbers when evaluated on numbers
   (CasADi ``DM``): force models through ``gmuk.optimize.parts.force_terms``, inequalities
   through ``parts.inequality_value``;
@@ -22,9 +23,8 @@ allows for a future loop that packs a parameter through a different float path).
 forms are the same formulas in CasADi's own arithmetic (different association and libm
 calls): 1e-12 of each block's size.
 
-A class whose declarations live in a file being rewritten for issue 24 (the compiled loop's
-constraint kernels) is listed in :data:`PENDING` with the reason; that list fails as soon
-as the class declares its forms, so that it is removed then.
+A class that cannot declare its forms yet is listed in :data:`PENDING` with the reason
+(none is); that list fails as soon as the class declares them, so that it is removed then.
 """
 
 from __future__ import annotations
@@ -47,6 +47,7 @@ from hypothesis import strategies as st
 
 import gmuk
 from gmuk._forms import FORMS, Forms
+from gmuk.constraints._kernels import apply_rows
 from gmuk.constraints.base import Constraint
 from gmuk.control._kernels import apply_control
 from gmuk.control.base import Controller
@@ -64,10 +65,7 @@ BASES = (ForceModel, Controller, Constraint)
 
 #: Built-in classes whose forms are declared in a file being rewritten (issue 24, items 1
 #: and 5: the constraints' compiled forms), with the reason.
-PENDING = {
-    "gmuk.constraints.tracking.ConfigurationTracking": "tracking.py is being rewritten",
-    "gmuk.constraints.relative.RelativeConstraint": "relative.py is being rewritten",
-}
+PENDING: dict[str, str] = {}
 
 
 # ---------------------------------------------------------------- discovery
@@ -551,13 +549,22 @@ def check_constraint(case: Case, forms: Forms) -> None:
     A, b = c.rows(state)
     A = A.toarray() if hasattr(A, "toarray") else np.asarray(A)
     assert np.isfinite(A).all() and np.isfinite(b).all()
-    assert not forms.has("compiled"), (
-        "no compiled comparison for constraints exists yet: add one here with the "
-        "constraint's compiled declaration"
-    )
-    assert "_compiled_term" not in dir(c)
     named = {b.name: b for b in case.system.bodies}
     bodies = [named[x] if isinstance(x, str) else x for x in c.bodies]
+    term = c._compiled_term()
+    if forms.has("compiled"):
+        assert term is not None, "declared compiled, but no term here"
+        code, params, n_rows = term
+        ends = [(np.array(state.pose(x)), np.array(state.twist(x))) for x in bodies]
+        (g1, V1), (g2, V2) = ends[0], ends[-1]
+        Ak, bk = np.empty((n_rows, 12)), np.empty(n_rows)
+        status = apply_rows(code, state.t, g1, V1, g2, V2, np.asarray(params, dtype=float), Ak, bk)
+        assert status == 0
+        _blocks_close(Ak[:, : 6 * len(bodies)].ravel(), A.ravel(), PYTHON_COMPILED_RTOL, "A")
+        _blocks_close(bk, b, PYTHON_COMPILED_RTOL, "compiled b")
+        assert not Ak[:, 6 * len(bodies) :].any()
+    else:
+        assert term is None, "declared without a compiled form, but has one"
     q = tuple(state.pose(x) if x.kind == "rigid" else state.position(x) for x in bodies)
     nu = tuple(state.twist(x) if x.kind == "rigid" else state.velocity(x) for x in bodies)
     q_dm, nu_dm = zip(*[_dm(state, x) for x in bodies], strict=True)

@@ -109,6 +109,29 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
         object.__setattr__(self, "_bodies", tuple(bodies))
         object.__setattr__(self, "_name", name or type(self).__name__)
 
+    def _compiled_term(self) -> tuple[int, tuple[float, ...], int] | None:
+        """How the compiled step loop computes this constraint's rows: (code of its kernel in
+        :mod:`gmuk.constraints._kernels`, parameters, number of rows), or None when its rows
+        come from Python. A constraint has the compiled form of the class that defines its
+        ``_kernel`` when its ``rows`` is that class's (a subclass that overrides ``rows`` has
+        none), and when ``_kernel_params()`` packs parameters for it."""
+        kernel = self._declared_form("_kernel")
+        if kernel is None:
+            return None
+        from gmuk.constraints._kernels import CODES
+
+        code = CODES.get(kernel)
+        packed = self._kernel_params() if code is not None else None
+        if code is None or packed is None:
+            return None
+        params, n_rows = packed
+        return code, tuple(float(v) for v in params), int(n_rows)
+
+    def _kernel_params(self) -> tuple[Any, int] | None:
+        """The parameters of ``_kernel`` and the number of rows; None when the kernel cannot
+        compute this constraint's rows."""
+        raise DefinitionError(f"{type(self).__name__} has no compiled kernel")
+
     @property
     def bodies(self) -> tuple[Body | str, ...]:
         """The bodies (objects or names) this constraint acts on, in column order."""

@@ -22,20 +22,53 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk import _uk_kernels
+from gmuk._forms import Forms
+from gmuk._numba import njit
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Baumgarte, Constraint
-from gmuk.errors import ConstraintError
+from gmuk.errors import ConstraintError, DefinitionError
 from gmuk.lie import se3
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
 
-__all__ = ["RelativeConstraint", "relative_twist"]
+__all__ = ["RelativeConstraint", "relative_constraint_rows", "relative_loop_rows", "relative_twist"]
 
 _ZERO6 = np.zeros(6)
 _ZERO6.setflags(write=False)
+
+
+@njit(cache=True)
+def relative_constraint_rows(gL, VL, gB, VB, S, a_des, alpha, v_des, A, b):  # type: ignore[no-untyped-def]
+    """The rows of a relative constraint into A (s, 12) (columns [V_L, V_B]) and b (s,):
+    ``S V̇_{B/L} = S a_des`` (module docstring), minus ``α_i (S (V_{B/L} − v_des))_i`` on each
+    row with a Baumgarte gain α_i ≠ 0. The one definition of :meth:`RelativeConstraint.rows`."""
+    V_BL = np.empty(6)
+    _uk_kernels.relative_rows(gL, VL, gB, VB, S, a_des, A, b, V_BL)
+    for a in range(S.shape[0]):
+        if alpha[a] != 0.0:
+            q = 0.0
+            for e in range(6):
+                q += S[a, e] * (V_BL[e] - v_des[e])
+            b[a] = b[a] - alpha[a] * q
+
+
+@njit(cache=True)
+def relative_loop_rows(t, gL, VL, gB, VB, p, A, b):  # type: ignore[no-untyped-def]
+    """The compiled rows of a relative constraint with no desired relative motion: p holds
+    the gains α (s) and S (s, 6) row by row. Returns 0."""
+    s = b.shape[0]
+    S = np.empty((s, 6))
+    alpha = np.empty(s)
+    for a in range(s):
+        alpha[a] = p[a]
+        for e in range(6):
+            S[a, e] = p[s + 6 * a + e]
+    zero = np.zeros(6)
+    relative_constraint_rows(gL, VL, gB, VB, S, zero, alpha, zero, A, b)
+    return 0
 
 
 def relative_twist(
@@ -87,6 +120,11 @@ class RelativeConstraint(Constraint):
     """
 
     body_kinds = frozenset({BodyKind.RIGID})
+    _forms = Forms(
+        compiled=True,
+        symbolic="gmuk.optimize transcribes no relative-acceleration constraint",
+    )
+    _kernel = staticmethod(relative_loop_rows)
 
     def __init__(
         self,
@@ -118,6 +156,26 @@ class RelativeConstraint(Constraint):
         self.acceleration = acceleration
         self.velocity = velocity
         self.baumgarte = baumgarte
+        self._alpha = np.zeros(S.shape[0])
+        if baumgarte is not None:
+            try:
+                self._alpha[:] = np.broadcast_to(
+                    np.asarray(baumgarte.alpha, dtype=float), (S.shape[0],)
+                )
+            except ValueError:
+                raise DefinitionError(
+                    "the Baumgarte gain alpha of a RelativeConstraint must be a scalar or one "
+                    f"per row of S ({S.shape[0]}); got shape {np.shape(baumgarte.alpha)}"
+                ) from None
+
+    def _kernel_params(self) -> tuple[list[float], int] | None:
+        """The gains and S, when no relative motion is prescribed (a_des = 0, and no
+        v_des under Baumgarte terms); None otherwise (the rows come from Python)."""
+        if self.acceleration is not None or (
+            self.baumgarte is not None and self.velocity is not None
+        ):
+            return None
+        return [*self._alpha, *self.S.ravel()], self.S.shape[0]
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) with columns [V_L, V_B]."""
@@ -131,16 +189,18 @@ class RelativeConstraint(Constraint):
                     f"constraint {self.name!r}: acceleration(t) returned shape {a_des.shape}; "
                     "expected (6,)"
                 )
+        v_des = _ZERO6
+        if self.baumgarte is not None and self.velocity is not None:
+            v_des = np.asarray(self.velocity(state.t), dtype=np.float64)
+            if v_des.shape != (6,):
+                raise ConstraintError(
+                    f"constraint {self.name!r}: velocity(t) returned shape {v_des.shape}; "
+                    "expected (6,)"
+                )
         s = self.S.shape[0]  # outputs allocated here: cheaper than arrays returned by numba
-        A, b, V_BL = np.empty((s, 12)), np.empty(s), np.empty(6)
-        _uk_kernels.relative_rows(
-            state.g[iL], state.V[iL], state.g[iB], state.V[iB], self.S, a_des, A, b, V_BL
-        )
-        if self.baumgarte is not None:
-            v_des = (
-                np.zeros(6)
-                if self.velocity is None
-                else np.asarray(self.velocity(state.t), dtype=float)
-            )
-            b = b - self.baumgarte.alpha * (self.S @ (V_BL - v_des))
+        A, b = np.empty((s, 12)), np.empty(s)
+        relative_constraint_rows(
+            state.g[iL], state.V[iL], state.g[iB], state.V[iB],
+            self.S, a_des, self._alpha, v_des, A, b,
+        )  # fmt: skip
         return A, b

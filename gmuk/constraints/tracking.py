@@ -15,18 +15,27 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gmuk import _uk_kernels
+from gmuk._forms import Forms
+from gmuk._numba import njit
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Baumgarte, Constraint
 from gmuk.errors import ConstraintError, DefinitionError
-from gmuk.lie import se3
+from gmuk.lie._kernels import _se3_Ad_into, _se3_inverse_into, _se3_log_into
+from gmuk.orbits._kernels import lvlh_state
 from gmuk.reference import ReferenceTrajectory
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
 
-__all__ = ["ConfigurationTracking", "project_to_se3", "tracking_errors"]
+__all__ = [
+    "ConfigurationTracking",
+    "lvlh_tracking_rows",
+    "project_to_se3",
+    "tracking_errors",
+    "tracking_rows",
+]
 
 _EYE6 = np.eye(6)
 _EYE6.setflags(write=False)
@@ -76,8 +85,81 @@ def tracking_errors(
     e_V : ndarray (6,)
         ``V − Ad_{g⁻¹ g_d} V_d``: the body twist of g_d⁻¹g (rad/s, m/s).
     """
-    g_err = se3._inverse(g_d) @ g
-    return se3._log(g_err), V - se3._Ad(se3._inverse(g_err)) @ V_d
+    e_g, e_V = np.empty(6), np.empty(6)
+    _errors(
+        np.asarray(g, dtype=np.float64),
+        np.asarray(V, dtype=np.float64),
+        np.asarray(g_d, dtype=np.float64),
+        np.asarray(V_d, dtype=np.float64),
+        e_g,
+        e_V,
+    )
+    return e_g, e_V
+
+
+@njit(cache=True)
+def _errors(g, V, gd, Vd, e_g, e_V):  # type: ignore[no-untyped-def]
+    """:func:`tracking_errors` into ``e_g`` and ``e_V`` (6,): e_g = log(g_d⁻¹ g),
+    e_V = V − Ad_{(g_d⁻¹ g)⁻¹} V_d."""
+    gd1 = np.empty((1, 4, 4))
+    for a in range(4):
+        for e in range(4):
+            gd1[0, a, e] = gd[a, e]
+    gd_inv = np.zeros((1, 4, 4))
+    _se3_inverse_into(gd1, gd_inv)
+    g_err = np.zeros((1, 4, 4))
+    for a in range(4):
+        for e in range(4):
+            q = 0.0
+            for m in range(4):
+                q += gd_inv[0, a, m] * g[m, e]
+            g_err[0, a, e] = q
+    log = np.empty((1, 6))
+    _se3_log_into(g_err, log)
+    g_err_inv = np.zeros((1, 4, 4))
+    _se3_inverse_into(g_err, g_err_inv)
+    Ad = np.zeros((1, 6, 6))
+    _se3_Ad_into(g_err_inv, Ad)
+    for a in range(6):
+        q = 0.0
+        for e in range(6):
+            q += Ad[0, a, e] * Vd[e]
+        e_V[a] = V[a] - q
+        e_g[a] = log[0, a]
+
+
+@njit(cache=True)
+def tracking_rows(g, V, gd, Vd, Vd_dot, baumgarte, alpha, beta, b):  # type: ignore[no-untyped-def]
+    """b (6,) of configuration tracking (A = I₆): Eq. 67 projected onto se(3), minus
+    ``α e_V + β e_g`` row by row when ``baumgarte`` (gains α, β (6,); errors of
+    :func:`tracking_errors`). The one definition of :meth:`ConfigurationTracking.rows`."""
+    _uk_kernels.tracking_b(g, V, gd, Vd, Vd_dot, b)
+    if baumgarte:
+        e_g = np.empty(6)
+        e_V = np.empty(6)
+        _errors(g, V, gd, Vd, e_g, e_V)
+        for a in range(6):
+            b[a] = b[a] - alpha[a] * e_V[a] - beta[a] * e_g[a]
+
+
+@njit(cache=True)
+def lvlh_tracking_rows(t, g, V, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
+    """The compiled rows of configuration tracking of an LVLH reference at time t: A (6, 12)
+    = [I₆ 0], b (6,). Parameters p: the orbit's n, e, μ, p, R_NP (9, row-major), the Baumgarte
+    flag, α (6), β (6). (g2, V2: no second body.) Returns 0."""
+    R_NP = np.empty((3, 3))
+    for a in range(3):
+        for e in range(3):
+            R_NP[a, e] = p[4 + 3 * a + e]
+    gd = np.empty((4, 4))
+    Vd = np.empty(6)
+    Vd_dot = np.empty(6)
+    lvlh_state(t, p[0], p[1], p[2], p[3], R_NP, gd, Vd, Vd_dot)
+    tracking_rows(g, V, gd, Vd, Vd_dot, p[13] != 0.0, p[14:20], p[20:26], b)
+    for r in range(6):
+        for c in range(12):
+            A[r, c] = 1.0 if r == c else 0.0
+    return 0
 
 
 class ConfigurationTracking(Constraint):
@@ -104,6 +186,11 @@ class ConfigurationTracking(Constraint):
     """
 
     body_kinds = frozenset({BodyKind.RIGID})
+    _forms = Forms(
+        compiled=True,
+        symbolic="gmuk.optimize transcribes tracking through the reference's own states",
+    )
+    _kernel = staticmethod(lvlh_tracking_rows)
 
     def __init__(
         self,
@@ -120,6 +207,26 @@ class ConfigurationTracking(Constraint):
             )
         self.reference = reference
         self.baumgarte = baumgarte
+        self._gains = np.zeros((2, 6))
+        if baumgarte is not None:
+            try:
+                self._gains[0] = np.broadcast_to(np.asarray(baumgarte.alpha, dtype=float), (6,))
+                self._gains[1] = np.broadcast_to(np.asarray(baumgarte.beta, dtype=float), (6,))
+            except ValueError:
+                raise DefinitionError(
+                    "the Baumgarte gains of a ConfigurationTracking must be scalars or 6-vectors "
+                    f"(one per row); got alpha {np.shape(baumgarte.alpha)}, beta "
+                    f"{np.shape(baumgarte.beta)}"
+                ) from None
+
+    def _kernel_params(self) -> tuple[list[float], int] | None:
+        """The LVLH reference's orbit and frame, and the Baumgarte gains; None for another
+        reference (its rows come from Python)."""
+        orbit = getattr(self.reference, "_compiled_orbit", lambda: None)()
+        if orbit is None:
+            return None
+        flag = 0.0 if self.baumgarte is None else 1.0
+        return [*orbit, flag, *self._gains[0], *self._gains[1]], 6
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """A = I₆ and b of Eq. 67 (projected), plus Baumgarte terms."""
@@ -141,8 +248,6 @@ class ConfigurationTracking(Constraint):
                 f"V_dot {Vd_dot.shape}; expected (4, 4), (6,), (6,)"
             )
         b = _empty(6)  # filled by the kernel (cheaper than a kernel returning an array)
-        _uk_kernels.tracking_b(g, V, gd, Vd, Vd_dot, b)
-        if self.baumgarte is not None:
-            e_g, e_V = tracking_errors(g, V, gd, Vd)  # the checked float64 arrays
-            b = b - self.baumgarte.alpha * e_V - self.baumgarte.beta * e_g
+        gains = self._gains
+        tracking_rows(g, V, gd, Vd, Vd_dot, self.baumgarte is not None, gains[0], gains[1], b)
         return _EYE6, b

@@ -48,8 +48,9 @@ from numba import types
 from numba.extending import intrinsic
 
 from gmuk._numba import discard_stale_caches, njit, sources_key
-from gmuk._uk_kernels import _qr_solve, relative_rows, rigid_free_accel, tracking_b, uk_rigid
+from gmuk._uk_kernels import _qr_solve, rigid_free_accel, uk_rigid
 from gmuk.bodies import BodyKind
+from gmuk.constraints._kernels import apply_rows
 from gmuk.control._kernels import apply_control
 from gmuk.errors import ConstraintError, DefinitionError
 from gmuk.forces._kernels import apply_term
@@ -57,14 +58,7 @@ from gmuk.gravity import _kernels as _field_kernels
 from gmuk.integrators import _dop853_tableau as _tab
 from gmuk.integrators._base import RungeKuttaMethod
 from gmuk.integrators.dop853 import DOP853
-from gmuk.lie._kernels import (
-    _compose_exp_into,
-    _dexp_inv_apply_into,
-    _se3_Ad_into,
-    _se3_inverse_into,
-    _se3_log_into,
-)
-from gmuk.orbits._kernels import lvlh_state
+from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
 
 if TYPE_CHECKING:
     from gmuk.state import State
@@ -82,7 +76,7 @@ class Status(enum.IntEnum):
     NONFINITE = -1  #: a derivative with NaN or inf
     UNDERFLOW = -2  #: step size underflow
     MAX_STEPS = -3  #: max_steps reached
-    FIELD = -4  #: a compiled force term failed (its kernel's code in ints[I_FIELD])
+    FIELD = -4  #: a compiled part's kernel failed (its status in ints[I_FIELD])
     CALLBACK = -5  #: a part evaluated in Python raised (PythonParts.error holds it)
 
 
@@ -648,67 +642,33 @@ class PythonParts:
 #: Accelerations' fields under the names of rhs's outputs (where they differ).
 _ACCELERATION_FIELDS = {"acceleration": "total", "constraint_acceleration": "constraint"}
 
-# Constraint kinds of the compiled right-hand side.
-TRACKING_LVLH = 0  #: ConfigurationTracking of an LVLHReference (Eq. 67), Baumgarte optional
-RELATIVE = 1  #: RelativeConstraint with a zero desired relative motion (Eq. 73)
-PYTHON = 2  #: any other constraint: its rows come from Python (PythonParts), at io[p0:]
-
-
-def _gains(baumgarte: Any, n: int) -> list[float] | None:
-    """[flag, α (n), β (n)] with the gains broadcast to n rows (zeros without Baumgarte), or
-    None when they do not broadcast."""
-    if baumgarte is None:
-        return [0.0] * (1 + 2 * n)
-    try:
-        alpha = np.broadcast_to(np.asarray(baumgarte.alpha, dtype=float), (n,))
-        beta = np.broadcast_to(np.asarray(baumgarte.beta, dtype=float), (n,))
-    except ValueError:
-        return None
-    return [1.0, *alpha.tolist(), *beta.tolist()]
+#: The constraint table's kind of a constraint whose rows come from Python (PythonParts, at
+#: io[p0:]); the others hold their kernel's code (gmuk.constraints._kernels).
+PYTHON = -1
 
 
 def _constraint_program(system: System, solve: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(cons (n_c, 6) int64 — kind, body, other body, first row, rows, parameter start —,
     parameters, the solve's packed constants) for the FREE, FUSED or DENSE solve. The row
-    counts of PYTHON constraints are left to :func:`program`."""
-    from gmuk.constraints.relative import RelativeConstraint
-    from gmuk.constraints.tracking import ConfigurationTracking
-    from gmuk.orbits.lvlh import LVLHReference
+    counts of PYTHON constraints and every constraint's first row are left to
+    :func:`program`."""
     from gmuk.solvers import QR_COND_LIMIT
 
     if solve == FREE:
         return np.zeros((0, 6), dtype=np.int64), np.zeros(1), np.zeros(1)
     rows: list[list[int]] = []
     params: list[float] = []
-    row = 0
-    rigid = BodyKind.RIGID
     for c in system.constraints:
         bodies = [system._resolve(b) for b in c.bodies]
+        term = c._compiled_term()
+        if term is None or len(bodies) > 2 or any(b.kind is not BodyKind.RIGID for b in bodies):
+            # rows from Python; program() sets their count and place
+            rows.append([PYTHON, 0, -1, 0, 0, 0])
+            continue
+        code, values, n_rows = term
         idx = [system.layout.slot(b).index for b in bodies]
-        start = len(params)
-        tracking = type(c) is ConfigurationTracking and type(c.reference) is LVLHReference
-        relative = (
-            type(c) is RelativeConstraint
-            and c.acceleration is None
-            and (c.baumgarte is None or c.velocity is None)
-        )
-        gains = None
-        if tracking or relative:
-            gains = _gains(c.baumgarte, 6 if tracking else np.asarray(c.S).shape[0])
-        if gains is None or any(b.kind is not rigid for b in bodies):
-            # rows from Python (another kind, or Baumgarte gains of a shape the kernels do
-            # not take); program() sets their count and place
-            rows.append([PYTHON, 0, 0, row, 0, 0])
-        elif tracking:
-            o = c.reference.orbit
-            params += [o.mean_motion, o.e, o.mu, o.p, *np.ravel(c.reference._R_NP), *gains]
-            rows.append([TRACKING_LVLH, idx[0], idx[0], row, 6, start])
-            row += 6
-        else:
-            S = np.asarray(c.S, dtype=float)
-            params += [*gains[1 : 1 + S.shape[0]], *S.ravel()]
-            rows.append([RELATIVE, idx[0], idx[1], row, S.shape[0], start])
-            row += S.shape[0]
+        rows.append([code, idx[0], idx[1] if len(idx) == 2 else -1, 0, n_rows, len(params)])
+        params += values
     cons = np.array(rows, dtype=np.int64).reshape(-1, 6)
     if solve == FUSED:
         fused: Any = system.solver  # a FusedRigidSolver (see _solve_mode)
@@ -881,7 +841,11 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
         # rigid bodies only, every load seen by the solve: the rows, then one compiled call
         A = np.zeros((s, ndof))
         b = np.empty(s)
-        _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
+        status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
+        if status != 0:
+            ints[I_FIELD] = status
+            _write_state(t, g, V, Y, d, io)
+            return FIELD
         out = np.empty(4 * ndof + s + 3)
         uk_rigid(V, modeled, A, b, parts.uk_params, out)
         if out[4 * ndof + s + 2] != 0.0:  # not certified: the Python solve decides
@@ -915,7 +879,11 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
         if s:  # the dense strategy's certified QR solve (DenseSolver.solve_rows)
             A = np.zeros((s, ndof))
             b = np.empty(s)
-            _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
+            status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
+            if status != 0:
+                ints[I_FIELD] = status
+                _write_state(t, g, V, Y, d, io)
+                return FIELD
             ac = aux[2 * ndof : 3 * ndof]
             P = parts.uk_params
             Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
@@ -990,14 +958,11 @@ def _apply_M(a, J, m_r, m_e, r_off, e_off, out):  # type: ignore[no-untyped-def]
 
 @njit(cache=True)
 def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[no-untyped-def]
-    """The stacked rows (A, b) of the constraints, as their ``rows`` give them: computed
-    here (a rigid body's columns start at its offset in ν, ``r_off``), or copied from ``io``
-    where PythonParts wrote them."""
-    gd = np.empty((4, 4))
-    Vd = np.empty(6)
-    Vd_dot = np.empty(6)
-    bk = np.empty(6)
-    R_NP = np.empty((3, 3))
+    """The stacked rows (A, b) of the constraints, as their ``rows`` give them: computed by
+    their kernels (gmuk.constraints._kernels; a rigid body's columns start at its offset in
+    ν, ``r_off``), or copied from ``io`` where PythonParts wrote them. Returns 0 or the
+    status of a failed kernel."""
+    ndof = A.shape[1]
     for c in range(cons.shape[0]):
         kind, i, j, r0, nrow, p0 = (
             cons[c, 0],
@@ -1007,84 +972,26 @@ def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[n
             cons[c, 4],
             cons[c, 5],
         )
-        if kind == TRACKING_LVLH:
-            for a in range(3):
-                for e in range(3):
-                    R_NP[a, e] = cparams[p0 + 4 + 3 * a + e]
-            lvlh_state(
-                t,
-                cparams[p0],
-                cparams[p0 + 1],
-                cparams[p0 + 2],
-                cparams[p0 + 3],
-                R_NP,
-                gd,
-                Vd,
-                Vd_dot,
-            )
-            tracking_b(g[i], V[i], gd, Vd, Vd_dot, bk)
-            if cparams[p0 + 13] != 0.0:
-                _baumgarte_tracking(g[i], V[i], gd, Vd, cparams[p0 + 14 :], cparams[p0 + 20 :], bk)
-            for r in range(6):
-                A[r0 + r, r_off[i] + r] = 1.0
-                b[r0 + r] = bk[r]
-        elif kind == PYTHON:  # A (nrow, n_dof) then b (nrow) at io[p0:]
-            ndof = A.shape[1]
+        if kind == PYTHON:  # A (nrow, n_dof) then b (nrow) at io[p0:]
             for a in range(nrow):
                 for e in range(ndof):
                     A[r0 + a, e] = io[p0 + a * ndof + e]
                 b[r0 + a] = io[p0 + nrow * ndof + a]
-        else:  # RELATIVE: columns [V_L, V_B]
-            S = np.empty((nrow, 6))
-            for a in range(nrow):
+            continue
+        Ak = np.empty((nrow, 12))
+        bk = np.empty(nrow)
+        second = j if j >= 0 else i
+        status = apply_rows(kind, t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk)
+        if status != 0:
+            return status
+        for a in range(nrow):
+            b[r0 + a] = bk[a]
+            for e in range(6):
+                A[r0 + a, r_off[i] + e] = Ak[a, e]
+            if j >= 0:
                 for e in range(6):
-                    S[a, e] = cparams[p0 + nrow + 6 * a + e]
-            Ak = np.empty((nrow, 12))
-            bkr = np.empty(nrow)
-            V_BL = np.empty(6)
-            relative_rows(g[i], V[i], g[j], V[j], S, np.zeros(6), Ak, bkr, V_BL)
-            for a in range(nrow):
-                alpha = cparams[p0 + a]
-                if alpha != 0.0:
-                    q = 0.0
-                    for e in range(6):
-                        q += S[a, e] * V_BL[e]
-                    bkr[a] = bkr[a] - alpha * q
-                b[r0 + a] = bkr[a]
-                for e in range(6):
-                    A[r0 + a, r_off[i] + e] = Ak[a, e]
                     A[r0 + a, r_off[j] + e] = Ak[a, 6 + e]
-
-
-@njit(cache=True)
-def _baumgarte_tracking(g, V, gd, Vd, alpha, beta, b):  # type: ignore[no-untyped-def]
-    """b ← b − α e_V − β e_g (gains per row) with e_g = log(g_d⁻¹ g) and
-    e_V = V − Ad_{(g_d⁻¹ g)⁻¹} V_d (gmuk.constraints.tracking.tracking_errors)."""
-    gd_inv = np.zeros((1, 4, 4))
-    gd1 = np.empty((1, 4, 4))
-    for a in range(4):
-        for e in range(4):
-            gd1[0, a, e] = gd[a, e]
-    _se3_inverse_into(gd1, gd_inv)
-    g_err = np.zeros((1, 4, 4))
-    for a in range(4):
-        for e in range(4):
-            q = 0.0
-            for m in range(4):
-                q += gd_inv[0, a, m] * g[m, e]
-            g_err[0, a, e] = q
-    e_g = np.empty((1, 6))
-    _se3_log_into(g_err, e_g)
-    g_err_inv = np.zeros((1, 4, 4))
-    _se3_inverse_into(g_err, g_err_inv)
-    Ad = np.zeros((1, 6, 6))
-    _se3_Ad_into(g_err_inv, Ad)
-    for a in range(6):
-        q = 0.0
-        for e in range(6):
-            q += Ad[0, a, e] * Vd[e]
-        e_V = V[a] - q
-        b[a] = b[a] - alpha[a] * e_V - beta[a] * e_g[0, a]
+    return 0
 
 
 @njit(cache=True)

@@ -229,6 +229,15 @@ class LVLHReference(ReferenceTrajectory):
     def __repr__(self) -> str:
         return f"LVLHReference({self._orbit!r})"
 
+    def _compiled_orbit(self) -> list[float] | None:
+        """The parameters the compiled loop evaluates this reference from (those of
+        :func:`gmuk.orbits._kernels.lvlh_state`: n, e, μ, p and R_NP row by row), or None for
+        a subclass with its own ``evaluate``."""
+        if type(self).evaluate is not LVLHReference.evaluate:
+            return None
+        o = self._orbit
+        return [o.mean_motion, o.e, o.mu, o.p, *np.ravel(self._R_NP)]
+
     def evaluate(self, t: float) -> ReferenceState:
         """Desired pose, body twist and twist rate at one time.
 
