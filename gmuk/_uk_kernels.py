@@ -1,11 +1,13 @@
 """Compiled kernels for the System's hot path (free accelerations, dense UK solve).
 
-:func:`uk_rigid_c` has one explicit signature so that the System can call its compiled
-function through :func:`gmuk._numba.entry`, without numba's dispatcher (which resolves the
-types of its arguments on every call). Such a call does not check its arguments: they must
-be exactly the declared types (float64, C-contiguous, the declared dimensions), or the
-kernel reads memory wrongly. The System checks that before it takes this path and calls the
-generic :func:`uk_rigid` otherwise.
+The compiled loop and the System's fused solve call :func:`uk_rigid` with the same argument
+types, :data:`UK_RIGID_SIGNATURE` (writable C-contiguous float64 arrays, the loop's): one
+compile of it and of its callees (or one load from numba's cache) serves both. The System
+calls that overload's compiled function directly, without numba's dispatcher (which
+resolves the types of its arguments on every call). Such a call does not check its
+arguments: they must be exactly the declared types (float64, C-contiguous, writable, the
+declared dimensions), or the kernel reads memory wrongly. The System checks that before it
+takes this path and calls the dispatcher otherwise.
 """
 
 from __future__ import annotations
@@ -15,9 +17,8 @@ from numba import types
 
 from gmuk._numba import njit
 
-_RO1 = types.Array(types.float64, 1, "C", readonly=True)
-_RO2 = types.Array(types.float64, 2, "C", readonly=True)
 _RW1 = types.Array(types.float64, 1, "C")
+_RW2 = types.Array(types.float64, 2, "C")
 
 
 @njit(cache=True)
@@ -290,9 +291,13 @@ def rigid_params(
     cond_limit: float,
     consistency_tol: float,
 ) -> np.ndarray:
-    """The constant arguments of :func:`uk_rigid` packed in one read-only vector:
+    """The constant arguments of :func:`uk_rigid` packed in one vector:
     ``[cond_limit, consistency_tol, J (9 n_b), J⁻¹ (9 n_b), m (n_b), M^{-1/2} (n²), M (n²)]``
-    for n_b rigid bodies and n = 6 n_b (one argument to unbox instead of seven)."""
+    for n_b rigid bodies and n = 6 n_b (one argument to unbox instead of seven).
+
+    Writable, as the compiled loop's parameters are: :func:`uk_rigid` then has the same
+    argument types from Python as from the loop, and one compile serves both (its owner
+    keeps it private instead of marking it read-only)."""
     P = np.concatenate(
         [
             [float(cond_limit), float(consistency_tol)],
@@ -303,7 +308,6 @@ def rigid_params(
             np.ravel(M),
         ]
     ).astype(np.float64)
-    P.setflags(write=False)
     return P
 
 
@@ -363,16 +367,9 @@ def uk_rigid(
     _uk_rigid(V, Q, A, b, P, out)
 
 
-#: The one signature of :func:`uk_rigid_c` (compiled on first use: gmuk._numba.compiled_entry).
-UK_RIGID_C_SIGNATURE = types.void(_RO2, _RO1, _RO2, _RO1, _RO1, _RW1)
-
-
-@njit(cache=True)
-def uk_rigid_c(
-    V: np.ndarray, Q: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, out: np.ndarray
-) -> None:
-    """:func:`uk_rigid` for C-contiguous float64 arrays (called through ``gmuk._numba.entry``)."""
-    _uk_rigid(V, Q, A, b, P, out)
+#: The signature of :func:`uk_rigid` that the compiled loop calls and the System's fused
+#: solve calls through its compiled entry (writable C-contiguous float64 arrays): one compile.
+UK_RIGID_SIGNATURE = types.void(_RW2, _RW1, _RW2, _RW1, _RW1, _RW1)
 
 
 @njit(cache=True)

@@ -40,7 +40,6 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from gmuk import _uk_kernels, uk
-from gmuk._numba import compiled_entry
 from gmuk._validation import FloatArray, all_finite
 from gmuk.bodies import Body, RigidBody
 from gmuk.constraints.tangent_bundle import TangentBundleConstraint
@@ -77,8 +76,10 @@ QR_COND_LIMIT = 1e8
 _EPS = float(np.finfo(float).eps)
 _F64 = np.dtype(np.float64)
 _empty = np.empty
-#: The compiled entry of :func:`gmuk._uk_kernels.uk_rigid_c`, made by :func:`_fused_entry`
-#: when the first System that takes the fused solve is built (not on import).
+#: The compiled entry of :func:`gmuk._uk_kernels.uk_rigid` for its one shared signature
+#: (:data:`gmuk._uk_kernels.UK_RIGID_SIGNATURE`, the compiled loop's argument types), made by
+#: :func:`_fused_entry` when the first System that takes the fused solve is built (not on
+#: import).
 _uk_rigid_c: Any = None
 #: The multipliers of a System without constraints (shared, read-only).
 _NO_MULTIPLIERS = np.zeros(0)
@@ -86,11 +87,24 @@ _NO_MULTIPLIERS.setflags(write=False)
 
 
 def _fused_entry() -> Any:
-    """The compiled entry of the fused solve, compiled (or loaded from the cache) once."""
+    """The compiled entry of the fused solve, compiled (or loaded from the cache) once.
+
+    The signature is the compiled loop's, so whichever of the two comes first compiles the
+    kernel (and its callees ``_qr_solve``, ``rigid_free_accel``) for both. The dispatcher
+    stays open to other types (arrays in other layouts take it).
+    """
     global _uk_rigid_c
     if _uk_rigid_c is None:
-        _uk_rigid_c = compiled_entry(_uk_kernels.uk_rigid_c, _uk_kernels.UK_RIGID_C_SIGNATURE)
+        kernel, sig = _uk_kernels.uk_rigid, _uk_kernels.UK_RIGID_SIGNATURE
+        kernel.compile(sig)  # the existing overload if the loop compiled it first
+        _uk_rigid_c = kernel.overloads[sig.args].entry_point
     return _uk_rigid_c
+
+
+def _writable(x: FloatArray) -> FloatArray:
+    """``x``, or a copy of it when it is read-only (same values, same C layout): the compiled
+    entry takes writable arrays only, the loop's types."""
+    return x if x.flags.writeable else x.copy()
 
 
 @dataclass(frozen=True, eq=False)
@@ -418,7 +432,9 @@ class FusedRigidSolver(DenseSolver):
                 and A.flags.c_contiguous
                 and b.flags.c_contiguous
             ):  # exactly the declared types: the compiled entry, no dispatch
-                _uk_rigid_c(V, modeled, A, b, self._params, out)
+                _uk_rigid_c(
+                    _writable(V), _writable(modeled), _writable(A), _writable(b), self._params, out
+                )
             else:
                 _uk_kernels.uk_rigid(V, modeled, A, b, self._params, out)
             status = float(out[-1])  # a Python float compares faster than a numpy scalar
