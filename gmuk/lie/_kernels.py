@@ -150,7 +150,9 @@ def _so3_log_into(R: np.ndarray, out: np.ndarray) -> None:
     """:func:`so3_log` written into ``out``."""
     n = R.shape[0]
     for k in range(n):
-        w0, w1, w2, _ = _rot_log(R[k])
+        # R[k, :3, :3], not R[k]: the block has the layout ("A") the compiled loop's
+        # _se3_log_into gives _rot_log, so one compile of _rot_log serves both
+        w0, w1, w2, _ = _rot_log(R[k, :3, :3])
         out[k, 0], out[k, 1], out[k, 2] = w0, w1, w2
 
 
@@ -211,9 +213,12 @@ def _compose_exp_into(G0: np.ndarray, xi: np.ndarray, out: np.ndarray) -> None:
 
 
 def compose_exp(G0: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """G0 · exp(ξ^) for (n, 4, 4) and (n, 6) → (n, 4, 4)."""
+    """G0 · exp(ξ^) for (n, 4, 4) and (n, 6) → (n, 4, 4).
+
+    The arrays are passed C-contiguous (copied if not): the kernel then has the compiled
+    loop's argument types, and one compile serves both."""
     out = np.empty((xi.shape[0], 4, 4))
-    _compose_exp_into(G0, xi, out)
+    _compose_exp_into(np.ascontiguousarray(G0), np.ascontiguousarray(xi), out)
     return out
 
 
@@ -368,7 +373,9 @@ def se3_errors(g: np.ndarray) -> tuple[float, float, float, int, int]:
             e = np.inf
         if e > worst_row:
             worst_row, k_row = e, k
-    orth, det, k_rot = rotation_errors(g[:, :3, :3])
+    # a C-contiguous copy of the blocks: rotation_errors then has the argument types that
+    # gmuk._validation.check_rotation gives it, and compiles once
+    orth, det, k_rot = rotation_errors(np.ascontiguousarray(g[:, :3, :3]))
     return worst_row, orth, det, k_rot, k_row
 
 
