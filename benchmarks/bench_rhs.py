@@ -13,9 +13,8 @@ right-hand side and the field's acceleration alone. Medians of 7 batches (µs pe
 Systems with parts in Python (issue #14's mixed systems): a rigid body and a point mass under
 point-mass gravity and a user's Python drag model (3000 s, DOP853 at 1e-11), called back
 from the compiled loop; and the FCCL scenario (``gmuk.scenarios.fccl.run()``, its
-Morse–Lyapunov controller compiled). Each with the compiled loop and with the Python loop (the
-scenario's
-``simulate`` calls forced to it by replacing ``_compiled.program`` for that timing).
+Morse–Lyapunov controller compiled). Each with the compiled loop and with the reference Python
+loop of ``gmuk.testing`` (the scenario's ``simulate`` calls sent to it for that timing).
 
 Run: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_rhs.py
 """

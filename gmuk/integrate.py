@@ -53,7 +53,7 @@ from gmuk.integrators import DOPRI5 as DOPRI5
 from gmuk.integrators import METHODS as METHODS
 from gmuk.integrators import RK4 as RK4
 from gmuk.integrators import RungeKuttaMethod as RungeKuttaMethod
-from gmuk.integrators import _compiled
+from gmuk.integrators import _compiled, _program
 from gmuk.integrators import get_method as get_method
 from gmuk.integrators import method_names as method_names
 from gmuk.integrators._base import label
@@ -322,7 +322,7 @@ def simulate(
             DeprecationWarning,
             stacklevel=2,
         )
-    _compiled.method_table(run.method)  # a method the loop cannot run: say so first
+    _program.method_table(run.method)  # a method the loop cannot run: say so first
     control = runs.current()
     checkpoint = control.next_path() if control is not None else None
     prefix: Trajectory | None = None
@@ -505,7 +505,7 @@ def _versions() -> dict[str, str]:
 
 
 #: The loop's output buffers: times, states Y, base poses and the right-hand side's other
-#: outputs (gmuk.integrators._compiled.aux_layout), one row per output.
+#: outputs (gmuk.integrators._program.aux_layout), one row per output.
 _Buffers = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
 
 
@@ -577,7 +577,7 @@ class _Loop:
         if self.checkpoint is not None and time.monotonic() - self.last_save >= control.every_s:
             self.save_checkpoint()
 
-    def _block(self, n_out: int, bufs: _Buffers, prog: _compiled.Program) -> dict[str, Any]:
+    def _block(self, n_out: int, bufs: _Buffers, prog: _program.Program) -> dict[str, Any]:
         """The first ``n_out`` buffered outputs as Trajectory columns."""
         bt, bY, bG, baux = (b[:n_out] for b in bufs)
         p = self.p
@@ -588,7 +588,7 @@ class _Loop:
             g = _kernels.compose_exp(np.ascontiguousarray(bG).reshape(-1, 4, 4), xi)
         else:
             g = np.zeros((0, 4, 4))
-        where = _compiled.aux_layout(lay.n_dof, prog.s, lay.n_control)
+        where = _program.aux_layout(lay.n_dof, prog.s, lay.n_control)
         columns = {name: baux[:, where[name]].copy() for name in where if name != "z_dot"}
         columns["rank"] = columns["rank"].astype(np.int64)
         return {
@@ -632,7 +632,7 @@ class _Loop:
         self.at = (Y.copy(), G0.copy(), float(fs[_compiled.F_H]), int(ints[_compiled.I_OUT]))
         # the program reads the row counts of Python constraints at the start: a part that
         # raises there fails the run at its start time
-        prog = _compiled.program(p.system, self.method, p.state(t, Y, G0))
+        prog = p.system.compiled_program(self.method, p.state(t, Y, G0))
         _compiled.compile_loop()
         fs[[_compiled.F_T, _compiled.F_END, _compiled.F_RTOL, _compiled.F_ATOL]] = (
             t, args.t1, self.rtol, self.atol,
@@ -673,7 +673,7 @@ class _Loop:
             self._after_chunk()
 
     def _failure(
-        self, status: int, prog: _compiled.Program, fs: FloatArray, ints: np.ndarray
+        self, status: int, prog: _program.Program, fs: FloatArray, ints: np.ndarray
     ) -> BaseException:
         """The exception that reports a failed chunk."""
         t_bad = float(fs[_compiled.F_BAD_T])
@@ -690,7 +690,7 @@ class _Loop:
             return self._field_failure(prog, t_bad, int(ints[_compiled.I_FIELD]))
         return _LoopFailure(f"non-finite derivative at t = {t_bad:.9g} s")
 
-    def _field_failure(self, prog: _compiled.Program, t_bad: float, code: int) -> BaseException:
+    def _field_failure(self, prog: _program.Program, t_bad: float, code: int) -> BaseException:
         """A compiled force kernel's failure, described by the model that failed: the
         System's Python accelerations at the failing stage (which the loop left in the
         program's ``io``) raise the model's own error."""

@@ -37,10 +37,13 @@ from gmuk.control.base import Controller
 from gmuk.errors import ConstraintError, DefinitionError, NonFiniteError
 from gmuk.forces.base import ForceModel
 from gmuk.integrate import simulate as _simulate
+from gmuk.integrators import _program
 from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
 from gmuk.state import Layout, State
 
 if TYPE_CHECKING:
+    from gmuk.integrators import RungeKuttaMethod
+    from gmuk.integrators._program import Program
     from gmuk.trajectory import Trajectory
 
 __all__ = ["QR_COND_LIMIT", "QR_MAX_ROWS", "SPARSE_THRESHOLD", "Accelerations", "System"]
@@ -718,6 +721,75 @@ class System:
                 "the state, the loads or the constraint rows too large for float64?"
             )
         return acc
+
+    # ------------------------------------------------------------------ compiled form
+    def compiled_program(self, method: RungeKuttaMethod, state: State) -> Program:
+        """This System's compiled form with ``method`` for a run from ``state``: the arrays
+        and the Python callback the compiled loop runs (:mod:`gmuk.integrators._program`).
+
+        Each part contributes what it declares (its ``_compiled_term``; parts without one are
+        called back in Python), and the solve runs compiled under the ``"fused"`` and
+        ``"dense"`` strategies, in Python otherwise (:attr:`compiled_solve`). The row counts
+        of constraints evaluated in Python are read at ``state``.
+
+        Raises
+        ------
+        DefinitionError
+            When the method replaces the tableau's step with its own Python.
+        Exception
+            Whatever a part raises when its rows are evaluated at ``state``.
+        """
+        solve, _ = self.compiled_solve
+        if solve == _program.FUSED:
+            constants = np.array(self.solver._params)  # type: ignore[attr-defined]
+        elif solve == _program.DENSE:
+            constants = self._Minv_sqrt
+        else:
+            constants = np.zeros(1)
+        view = _program.SystemView(
+            layout=self.layout,
+            bodies=self.bodies,
+            constraints=self.constraints,
+            constraint_bodies=[[self._resolve(b) for b in c.bodies] for c in self.constraints],
+            constraint_cols=self._constraint_cols,
+            constraint_where=self._constraint_where,
+            force_plan=self._force_plan,
+            controllers=self.controllers,
+            controller_bodies=self._ctrl_bodies,
+            controller_slices=self._ctrl_slices,
+            J=self._J,
+            Jinv=self._Jinv,
+            m_rigid=self._m_rigid,
+            m_euclid=self._m_euclid,
+            plant_only=self._plant_only_loads,
+            solve=solve,
+            solve_constants=constants,
+            consistency_tol=self.consistency_tol,
+            rcond=self.rcond,
+            accelerations=(
+                self.accelerations
+                if type(self).accelerations is not System.accelerations
+                else self._accelerations
+            ),
+            add_loads=self._add_loads,
+            controls_of=self._controls_of,
+            rows_of=_pair,
+        )
+        return _program.build(view, method, state)
+
+    @property
+    def compiled_solve(self) -> tuple[int, str]:
+        """How the compiled loop solves this System (``gmuk.integrators._program``'s FREE,
+        FUSED, DENSE or PYTHON_SOLVE) and, for PYTHON_SOLVE, why."""
+        if type(self).accelerations is not System.accelerations:
+            return _program.PYTHON_SOLVE, "the System subclass has its own accelerations"
+        if not self.constraints:
+            return _program.FREE, ""
+        if type(self.solver) is solvers.FusedRigidSolver:
+            return _program.FUSED, ""
+        if type(self.solver) is solvers.DenseSolver:
+            return _program.DENSE, ""
+        return _program.PYTHON_SOLVE, f"the constraints are solved by {type(self.solver).__name__}"
 
     # ------------------------------------------------------------------ simulation
     def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:

@@ -17,6 +17,7 @@ import gmuk
 from gmuk import _numba, integrate, runs, testing
 from gmuk.errors import DefinitionError, SimulationError
 from gmuk.integrators import _compiled, get_method
+from gmuk.integrators import _program as program_records
 from gmuk.testing import reference_simulate
 
 MU = 4.9028e12  # m³/s², the Moon
@@ -116,8 +117,8 @@ def _system(forces):
 
 
 def _program(system, state, method="DOP853"):
-    prog = _compiled.program(system, get_method(method), state)
-    assert isinstance(prog, _compiled.Program), prog
+    prog = system.compiled_program(get_method(method), state)
+    assert isinstance(prog, program_records.Program), prog
     return prog
 
 
@@ -255,9 +256,9 @@ def test_a_system_whose_solve_is_not_compiled_runs_with_its_accelerations_called
         r={"p": [0.0, R0, 0.0]},
         v={"p": [-V0, 0.0, 0.0]},
     )
-    assert why in _compiled._solve_mode(system)[1]
+    assert why in system.compiled_solve[1]
     prog = _program(system, state)
-    assert prog.parts.dims.solve == _compiled.PYTHON_SOLVE
+    assert prog.parts.dims.solve == program_records.PYTHON_SOLVE
     kw = {"rtol": 1e-9, "atol": 1e-9, "t_eval": [0.0, 50.0, 100.0]}
     traj = system.simulate(state, (0.0, 100.0), **kw)
     ref = reference_simulate(system, state, (0.0, 100.0), **kw)
@@ -319,8 +320,8 @@ def _pair_and_damper():
 
 def test_a_user_constraint_among_compiled_ones_runs_compiled_and_equals_the_python_run():
     system, state = _pair_and_damper()
-    prog = _compiled.program(system, get_method("DOP853"), state)
-    assert isinstance(prog, _compiled.Program) and prog.s == 12
+    prog = system.compiled_program(get_method("DOP853"), state)
+    assert isinstance(prog, program_records.Program) and prog.s == 12
     assert prog.parts.dims.python_parts and len(prog.python.constraints) == 1
     fast, slow = _pair_runs(system, state)
     scale = np.abs(slow.multipliers).max()
@@ -413,9 +414,9 @@ def _controlled(constrained):
 @pytest.mark.parametrize("constrained", [False, True], ids=["free", "dense solve"])
 def test_controllers_and_the_dense_solve_run_compiled_and_equal_the_python_run(constrained):
     system, state = _controlled(constrained)
-    prog = _compiled.program(system, get_method("DOP853"), state)
-    assert isinstance(prog, _compiled.Program), prog
-    assert prog.parts.dims.solve == (_compiled.DENSE if constrained else _compiled.FREE)
+    prog = system.compiled_program(get_method("DOP853"), state)
+    assert isinstance(prog, program_records.Program), prog
+    assert prog.parts.dims.solve == (program_records.DENSE if constrained else program_records.FREE)
     _assert_same_right_hand_sides(system, state, prog)
     # Whole runs. Held on the sphere, the point mass's error estimate cancels so deeply that
     # rounding moves DOP853's step sizes (1e-10 relative by the fourth step, then more):
@@ -466,9 +467,9 @@ def test_compiled_rows_find_rigid_bodies_after_point_masses_under_the_dense_solv
         v={"p": [-V0, 0.0, 20.0]},
     )
     assert system.layout.rigid_offsets.tolist() == [3, 9]
-    prog = _compiled.program(system, get_method("DOP853"), state)
-    assert isinstance(prog, _compiled.Program), prog
-    assert prog.parts.dims.solve == _compiled.DENSE and prog.s == 12
+    prog = system.compiled_program(get_method("DOP853"), state)
+    assert isinstance(prog, program_records.Program), prog
+    assert prog.parts.dims.solve == program_records.DENSE and prog.s == 12
     _assert_same_right_hand_sides(system, state, prog)
     kw = {"method": "RK4", "step": 5.0, "t_eval": np.linspace(0, 300, 7)}
     fast = system.simulate(state, (0.0, 300.0), **kw)
@@ -578,8 +579,8 @@ def _with_constraints(constraints):
 @pytest.mark.parametrize("case", sorted(CALLED_BACK))
 def test_built_in_parts_without_a_compiled_form_run_called_back_as_in_the_python_loop(case):
     system, state = CALLED_BACK[case]()
-    prog = _compiled.program(system, get_method("RK4"), state)
-    assert isinstance(prog, _compiled.Program), prog
+    prog = system.compiled_program(get_method("RK4"), state)
+    assert isinstance(prog, program_records.Program), prog
     assert prog.parts.dims.python_parts
     _assert_same_right_hand_sides(system, state, prog)
     # the printed law diverges on this orbit (docs/errata.rst; with its integral gain of
@@ -608,8 +609,8 @@ def test_built_in_parts_without_a_compiled_form_run_called_back_as_in_the_python
 )
 def test_the_morse_lyapunov_law_runs_compiled_and_equals_the_python_one(law):
     system, state = _fccl(**law)
-    prog = _compiled.program(system, get_method("DOP853"), state)
-    assert isinstance(prog, _compiled.Program), prog
+    prog = system.compiled_program(get_method("DOP853"), state)
+    assert isinstance(prog, program_records.Program), prog
     assert not prog.parts.dims.python_parts and prog.parts.ctrls.shape == (1, 5)  # all compiled
     _assert_same_right_hand_sides(system, state, prog)
     kw = {"t_eval": np.linspace(0.0, 3000.0, 7), "rtol": 1e-10, "atol": 1e-10}
@@ -640,8 +641,8 @@ def test_inequality_constraints_with_slack_coordinates_run_compiled_as_in_the_py
     state = system.state(
         g={"sc": state.g[0]}, V={"sc": state.V[0]}, r={"p": state.x}, v={"p": state.xdot}
     )
-    prog = _compiled.program(system, get_method("DOP853"), state)
-    assert isinstance(prog, _compiled.Program), prog
+    prog = system.compiled_program(get_method("DOP853"), state)
+    assert isinstance(prog, program_records.Program), prog
     assert system.layout.n_euclid == 4 and prog.parts.point_starts.tolist() == [12, 16]
     _assert_same_right_hand_sides(system, state, prog)
     kw = {"t_eval": np.linspace(0.0, 600.0, 7), "rtol": 1e-10, "atol": 1e-10}
@@ -876,7 +877,7 @@ def test_a_constrained_compiled_run_equals_the_python_run():
 
 # ------------------------------------------------------------ compiling once per machine
 def test_every_program_has_the_argument_types_the_loop_is_compiled_for():
-    reference = _compiled.signature(_compiled.reference_program())
+    reference = _compiled.signature()
     runs_ = [_system(make()) for make in CASES.values()]
     runs_ += [_pair(None), _pair(gmuk.Baumgarte(0.5, 0.06))]
     for system, state in runs_:
