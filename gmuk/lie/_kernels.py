@@ -374,8 +374,14 @@ def se3_errors(g: np.ndarray) -> tuple[float, float, float, int, int]:
         if e > worst_row:
             worst_row, k_row = e, k
     # a C-contiguous copy of the blocks: rotation_errors then has the argument types that
-    # gmuk._validation.check_rotation gives it, and compiles once
-    orth, det, k_rot = rotation_errors(np.ascontiguousarray(g[:, :3, :3]))
+    # gmuk._validation.check_rotation gives it, and compiles once (explicit loops, not
+    # np.ascontiguousarray, whose own compile costs what the second one saved)
+    R = np.empty((g.shape[0], 3, 3))
+    for k in range(g.shape[0]):
+        for i in range(3):
+            for j in range(3):
+                R[k, i, j] = g[k, i, j]
+    orth, det, k_rot = rotation_errors(R)
     return worst_row, orth, det, k_rot, k_row
 
 
