@@ -36,9 +36,11 @@ Kernels that call kernels of other modules
 numba checks a cached kernel against its own source file only, yet a kernel's compiled code
 contains every kernel it calls, from any module: the compiled step loop holds the force,
 constraint, controller and solve kernels. :func:`sources_key` is a digest of every gmuk source
-that defines a kernel; a cache whose recorded digest differs (a kernel edited anywhere, in a
-development install) has all of gmuk's kernel caches discarded before anything is loaded from
-it (:func:`discard_stale_caches`).
+that defines a kernel. Each cache folder of gmuk's kernels records the digest it was written
+under (``gmuk-kernels.key``); the first time a process looks up a kernel in a folder whose
+digest differs (a kernel edited anywhere, in a development install), the folder's cache
+indexes are removed before anything is loaded from it (:func:`check_cache_folder`), and the
+kernels compile again and write new ones.
 
 Calling without the dispatcher
 ------------------------------
@@ -54,7 +56,6 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import importlib
 import inspect
 import os
 import sys
@@ -73,16 +74,13 @@ from gmuk.errors import GmukWarning
 __all__ = [
     "LazyEntries",
     "cache_plan",
+    "check_cache_folder",
     "compiled_entry",
-    "discard_stale_caches",
     "entry",
     "njit",
     "sources_key",
     "user_cache_dir",
 ]
-
-#: Every cached kernel made by :func:`njit` in this process.
-_CACHED: list[Any] = []
 
 #: numba's configuration module (its settings are attributes made at run time).
 _config: Any = numba.config
@@ -184,6 +182,9 @@ class _CheckedCache(FunctionCache):
     index is removed (so that the next save writes a fresh one) and the kernel compiles."""
 
     def load_overload(self, sig: Any, target_context: Any) -> Any:
+        folder = getattr(self, "_cache_path", None)
+        if folder:
+            check_cache_folder(Path(folder))
         try:
             return super().load_overload(sig, target_context)
         except Exception as exc:  # a damaged or foreign file: pickle, EOF, OS errors …
@@ -225,7 +226,6 @@ def _checked(dispatcher: Any) -> Any:
     """``dispatcher`` with its numba cache replaced by :class:`_CheckedCache`."""
     if type(getattr(dispatcher, "_cache", None)) is FunctionCache:
         dispatcher._cache.__class__ = _CheckedCache
-        _CACHED.append(dispatcher)
     return dispatcher
 
 
@@ -246,32 +246,32 @@ def sources_key() -> str:
     return digest.hexdigest()
 
 
-def discard_stale_caches(key_file: Path) -> bool:
-    """Discard gmuk's kernel caches when ``key_file`` does not hold :func:`sources_key`, and
-    record the key. Returns whether caches were discarded.
+_CHECKED_FOLDERS: set[Path] = set()
 
-    Every module that defines kernels is imported first, so that every cache is known; each
-    kernel's cache index is removed (numba then compiles it again and writes a new one)."""
+
+def check_cache_folder(folder: Path) -> bool:
+    """Remove the cache indexes in ``folder`` (one of gmuk's kernel cache folders) unless it
+    records :func:`sources_key`, and record the key; once per folder and process, before the
+    first lookup there. Returns whether indexes were removed."""
+    if folder in _CHECKED_FOLDERS:
+        return False
+    _CHECKED_FOLDERS.add(folder)
     key = sources_key()
+    key_file = folder / "gmuk-kernels.key"
     try:
         if key_file.read_text(encoding="ascii") == key:
             return False
     except (OSError, UnicodeDecodeError):
         pass
-    root = Path(__file__).resolve().parent
-    for path in _kernel_sources():
-        module = ".".join(("gmuk", *path.relative_to(root).with_suffix("").parts))
-        with _suppressed():
-            importlib.import_module(module)
-    for dispatcher in _CACHED:
-        index = getattr(getattr(dispatcher._cache, "_cache_file", None), "_index_path", None)
-        if index is not None:
-            with _suppressed():
-                os.unlink(index)
+    removed = False
     with _suppressed():
-        key_file.parent.mkdir(parents=True, exist_ok=True)
+        for index in folder.glob("*.nbi"):
+            os.unlink(index)
+            removed = True
+    with _suppressed():
+        folder.mkdir(parents=True, exist_ok=True)
         key_file.write_text(key, encoding="ascii")
-    return True
+    return removed
 
 
 def njit(*args: Any, **options: Any) -> Any:

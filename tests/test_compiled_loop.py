@@ -1019,30 +1019,37 @@ def test_the_same_inputs_give_the_same_bits_on_a_cold_and_a_warm_cache(tmp_path)
 def test_a_cache_compiled_from_other_kernel_sources_is_discarded_and_rebuilt(tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
     outputs = []
-    for name in ("first", "stale"):
+    for name in ("first", "stale", "warm"):
         out = tmp_path / f"{name}.npz"
         proc = subprocess.run(
             [sys.executable, "-c", _RUN_AND_SAVE, str(out)],
             env=env, capture_output=True, text=True, check=True,
         )  # fmt: skip
         outputs.append((proc, np.load(out)))
-        (key,) = (tmp_path / "numba").rglob("gmuk-kernels.key")
-        assert key.read_text() == _numba.sources_key()
-        key.write_text("the digest of an edited kernel")  # as if a kernel had changed
-    (_, a), (stale, b) = outputs
+        keys = list((tmp_path / "numba").rglob("gmuk-kernels.key"))
+        assert keys and all(k.read_text() == _numba.sources_key() for k in keys)
+        if name == "first":
+            for key in keys:  # as if a kernel had been edited since
+                key.write_text("the digest of other kernel sources")
+    (_, a), (stale, b), (warm, c) = outputs
     assert "compiling the integrator loop" in stale.stderr  # not loaded from the old cache
+    assert "compiling" not in warm.stderr  # and what it compiled is cached again
     for k in ("t", "g_NB", "V_B", "acceleration"):
-        assert a[k].tobytes() == b[k].tobytes()
+        assert a[k].tobytes() == b[k].tobytes() == c[k].tobytes()
 
 
-def test_the_loop_cache_is_stale_when_the_kernel_sources_differ(tmp_path, monkeypatch):
-    key = tmp_path / "gmuk-kernels.key"
-    monkeypatch.setattr(_compiled, "_key_path", lambda: key)
-    assert _compiled._cache_is_stale()  # no key yet
-    key.write_text(_numba.sources_key())
-    assert not _compiled._cache_is_stale()
-    key.write_text("another")
-    assert _compiled._cache_is_stale()
+def test_a_cache_folder_written_under_other_kernel_sources_is_emptied_once(tmp_path):
+    folder = tmp_path / "cache"
+    folder.mkdir()
+    (folder / "m.kernel-1.py311.nbi").write_bytes(b"index")
+    (folder / "m.kernel-1.py311.0.nbc").write_bytes(b"data")
+    assert _numba.check_cache_folder(folder)  # no key: written under unknown sources
+    assert not list(folder.glob("*.nbi")) and (folder / "gmuk-kernels.key").exists()
+    (folder / "m.kernel-1.py311.nbi").write_bytes(b"a new index")
+    assert not _numba.check_cache_folder(folder)  # once per process
+    assert (folder / "m.kernel-1.py311.nbi").exists()
+    _numba._CHECKED_FOLDERS.discard(folder)
+    assert not _numba.check_cache_folder(folder)  # the key matches
     # every source that defines a kernel is in the digest
     sources = {p.name for p in _numba._kernel_sources()}
     assert {"_compiled.py", "_kernels.py", "gravity.py", "_uk_kernels.py"} <= sources

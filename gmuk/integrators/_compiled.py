@@ -49,7 +49,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-from gmuk._numba import discard_stale_caches, njit, sources_key
+from gmuk._numba import njit
 from gmuk._uk_kernels import _qr_solve, rigid_free_accel, uk_rigid
 from gmuk.constraints._kernels import apply_rows
 from gmuk.control._kernels import apply_control
@@ -904,8 +904,6 @@ def loaded(prog: Program | None = None) -> bool:
         return True
     from numba.core.compiler_lock import global_compiler_lock
 
-    if _cache_is_stale():
-        return False
     sig = signature(prog)
     try:
         with global_compiler_lock:
@@ -965,22 +963,7 @@ def compile_loop(*, announce: bool = True, timeout: float = 900.0) -> bool:
     return True
 
 
-def _key_path() -> Path:
-    """Where the digest of the kernel sources the cached loop was compiled from is kept."""
-    return _lock_path().parent / "gmuk-kernels.key"
-
-
-def _cache_is_stale() -> bool:
-    """Whether the cached loop may hold kernels of other sources than this gmuk's."""
-    try:
-        return _key_path().read_text(encoding="ascii") != sources_key()
-    except (OSError, UnicodeDecodeError):
-        return True
-
-
 def _compile_now() -> None:
-    # A cache compiled from other kernel sources is discarded whole (gmuk._numba).
-    discard_stale_caches(_key_path())
     # The force kernels call the field kernel's one compiled signature (read-only data):
     # resolving it first loads it (or compiles it once) and keeps the loop from compiling
     # a second copy for other argument types.
