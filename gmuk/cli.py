@@ -49,6 +49,7 @@ from typing import Any, NoReturn
 
 from gmuk import runs, scenarios
 from gmuk.errors import GmukError
+from gmuk.integrate import versions
 from gmuk.runs import RunControl
 from gmuk.scenarios import OptionError, Scenario
 from gmuk.trajectory import write_text_atomic
@@ -277,6 +278,8 @@ def _run(argv: Sequence[str]) -> int:
         "options": {k: list(v) if isinstance(v, tuple) else v for k, v in options.items()},
         **({"orbits": options["orbits"]} if "orbits" in options else {}),
         "wall_time_s": elapsed,
+        # what computed it: the same inputs give the same bits under the same versions
+        "versions": primary.stats.get("versions") or versions(),
         **result.summary,
     }
     write_text_atomic(out / "summary.json", json.dumps(summary, indent=2, default=str) + "\n")

@@ -64,7 +64,7 @@ from gmuk.trajectory import _ARRAYS, Trajectory
 if TYPE_CHECKING:
     from gmuk.system import Accelerations, System
 
-__all__ = ["METHODS", "compile_loop", "simulate"]
+__all__ = ["METHODS", "compile_loop", "simulate", "versions"]
 
 #: Compile the step loop now (once per machine); :func:`simulate` does it on first use.
 compile_loop = _compiled.compile_loop
@@ -495,7 +495,7 @@ class _LoopFailure(GmukError, RuntimeError):
     derivative (the message says which)."""
 
 
-def _versions() -> dict[str, str]:
+def versions() -> dict[str, str]:
     """The versions of gmuk and the libraries that computed a run."""
     import numba
 
@@ -542,7 +542,7 @@ class _Loop:
             "rtol": self.rtol,
             "atol": self.atol,
             "compiled": True,
-            "versions": _versions(),
+            "versions": versions(),
         }
 
     def save_checkpoint(self, traj: Trajectory | None = None) -> None:

@@ -11,6 +11,7 @@ import inspect
 import json
 from pathlib import Path
 
+import numba
 import numpy as np
 import pytest
 
@@ -123,6 +124,12 @@ def test_a_scenario_registered_in_one_line_runs_with_its_declared_options(
     assert cli.main(argv) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenario"] == "tumble"
+    # what computed it, as the trajectory records it too
+    assert summary["versions"] == {
+        "gmuk": gmuk.__version__,
+        "numba": numba.__version__,
+        "numpy": np.__version__,
+    }
     assert summary["options"] == {"spin": 2.0, "moments": [1.0, 2.0, 2.5], "duration": 5.0}
     assert summary["spin_rad_s"] == 2.0 and summary["moments_kg_m2"] == [1.0, 2.0, 2.5]
     assert summary["energy_relative_drift"] < 1e-9
@@ -130,6 +137,7 @@ def test_a_scenario_registered_in_one_line_runs_with_its_declared_options(
     assert (out / "omega.png").is_file()
     traj = gmuk.load_trajectory(out / "trajectory.npz")
     assert traj.t[-1] == 5.0 and traj.body_names == ("box",)
+    assert traj.stats["versions"] == summary["versions"]
     assert "tumble (spin=2.0, moments=1.0,2.0,2.5, duration=5.0)" in capsys.readouterr().out
 
 
