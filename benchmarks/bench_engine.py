@@ -139,7 +139,7 @@ def breakdown() -> None:
         ("ConfigurationTracking.rows (incl. evaluate)", lambda: c.rows(st)),
         ("rows + checks (System._stack_rows)", lambda: S._stack_rows(st, check_finite=False)),
         ("compiled solve, numba dispatcher (uk_rigid)", lambda: _uk_kernels.uk_rigid(*args)),
-        ("compiled solve, compiled entry (uk_rigid_c)", lambda: compiled(*args)),
+        ("compiled solve, compiled entry (no dispatch)", lambda: compiled(*args)),
     ]
     for label, fn in parts:
         t = min(timeit.repeat(fn, number=5000, repeat=9)) / 5000
