@@ -22,7 +22,7 @@ from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Baumgarte, Constraint
 from gmuk.errors import ConstraintError, DefinitionError
 from gmuk.lie._kernels import _se3_Ad_into, _se3_inverse_into, _se3_log_into
-from gmuk.orbits._kernels import lvlh_state
+from gmuk.orbits._kernels import lvlh_state_packed
 from gmuk.reference import ReferenceTrajectory
 
 if TYPE_CHECKING:
@@ -147,14 +147,10 @@ def lvlh_tracking_rows(t, g, V, g2, V2, p, A, b):  # type: ignore[no-untyped-def
     """The compiled rows of configuration tracking of an LVLH reference at time t: A (6, 12)
     = [I₆ 0], b (6,). Parameters p: the orbit's n, e, μ, p, R_NP (9, row-major), the Baumgarte
     flag, α (6), β (6). (g2, V2: no second body.) Returns 0."""
-    R_NP = np.empty((3, 3))
-    for a in range(3):
-        for e in range(3):
-            R_NP[a, e] = p[4 + 3 * a + e]
     gd = np.empty((4, 4))
     Vd = np.empty(6)
     Vd_dot = np.empty(6)
-    lvlh_state(t, p[0], p[1], p[2], p[3], R_NP, gd, Vd, Vd_dot)
+    lvlh_state_packed(t, p, gd, Vd, Vd_dot)
     tracking_rows(g, V, gd, Vd, Vd_dot, p[13] != 0.0, p[14:20], p[20:26], b)
     for r in range(6):
         for c in range(12):

@@ -92,7 +92,7 @@ from gmuk.control.base import Controller
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3, so3
 from gmuk.lie._kernels import _ad_apply, _cross
-from gmuk.orbits._kernels import lvlh_state
+from gmuk.orbits._kernels import lvlh_state_packed
 from gmuk.reference import ReferenceTrajectory
 
 if TYPE_CHECKING:
@@ -164,6 +164,20 @@ def _Ad_apply(R, p, V, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
+def _Ad_error_inverse(E_R, q, v, out):  # type: ignore[no-untyped-def]
+    """``Ad_{E_g⁻¹} v`` into ``out`` (6,) for the error E_g with rotation E_R and position
+    error q (body frame): the nominal's twist or twist rate seen from the body."""
+    Re = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            Re[i, j] = E_R[j, i]
+    pe = np.empty(3)
+    for i in range(3):
+        pe[i] = -q[i]
+    _Ad_apply(Re, pe, v, out)
+
+
+@njit(cache=True)
 def morse_lyapunov_errors(g, V, gn, Vn, a, k11, k12, E_R, q, E_V, Vn_B, s, psi):  # type: ignore[no-untyped-def]
     """The corrected law's errors of pose g (4, 4) and twist V (6,) against the nominal
     (gn, Vn), written into E_R (3, 3), q (3,), E_V, Vn_B (6,), s (3,) and ψ (6,):
@@ -178,14 +192,7 @@ def morse_lyapunov_errors(g, V, gn, Vn, a, k11, k12, E_R, q, E_V, Vn_B, s, psi):
     d0, d1, d2 = g[0, 3] - gn[0, 3], g[1, 3] - gn[1, 3], g[2, 3] - gn[2, 3]
     for i in range(3):
         q[i] = g[0, i] * d0 + g[1, i] * d1 + g[2, i] * d2
-    Re = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            Re[i, j] = E_R[j, i]
-    pe = np.empty(3)
-    for i in range(3):
-        pe[i] = -q[i]
-    _Ad_apply(Re, pe, Vn, Vn_B)
+    _Ad_error_inverse(E_R, q, Vn, Vn_B)
     for i in range(6):
         E_V[i] = V[i] - Vn_B[i]
     _morse_s_into(E_R, a, s)
@@ -214,15 +221,8 @@ def morse_lyapunov_law(g, V, a_model, z, gn, Vn, Vdn, p, u, psi):  # type: ignor
     Vn_B = np.empty(6)
     s = np.empty(3)
     morse_lyapunov_errors(g, V, gn, Vn, a, k11, k12, E_R, q, E_V, Vn_B, s, psi)
-    Re = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            Re[i, j] = E_R[j, i]
-    pe = np.empty(3)
-    for i in range(3):
-        pe[i] = -q[i]
     Vdn_B = np.empty(6)
-    _Ad_apply(Re, pe, Vdn, Vdn_B)
+    _Ad_error_inverse(E_R, q, Vdn, Vdn_B)
     Q = np.empty((3, 3))
     _morse_q_into(E_R, a, Q)
     l_dot = np.empty(6)
@@ -256,14 +256,10 @@ def morse_lyapunov_lvlh(t, g, V, a_model, z, p, u, psi):  # type: ignore[no-unty
     """:func:`morse_lyapunov_law` tracking an :class:`~gmuk.orbits.LVLHReference`, its nominal
     at time t evaluated here (:func:`gmuk.orbits._kernels.lvlh_state`); ``p`` as
     :data:`N_LVLH_PARAMS` describes."""
-    R_NP = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            R_NP[i, j] = p[4 + 3 * i + j]
     gn = np.empty((4, 4))
     Vn = np.empty(6)
     Vdn = np.empty(6)
-    lvlh_state(t, p[0], p[1], p[2], p[3], R_NP, gn, Vn, Vdn)
+    lvlh_state_packed(t, p, gn, Vn, Vdn)
     morse_lyapunov_law(g, V, a_model, z, gn, Vn, Vdn, p[13:], u, psi)
 
 

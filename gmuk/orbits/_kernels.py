@@ -70,3 +70,15 @@ def lvlh_state(t, mean_motion, e, mu, p, R, g, V, V_dot):  # type: ignore[no-unt
     V_dot[3] = mu / (r * r) + fd * v2
     V_dot[4] = -fd * v1
     V_dot[5] = 0.0
+
+
+@njit(cache=True)
+def lvlh_state_packed(t, p, g, V, V_dot):  # type: ignore[no-untyped-def]
+    """:func:`lvlh_state` with the reference packed as the compiled parts pack it (what
+    :meth:`gmuk.orbits.LVLHReference._compiled_orbit` gives): p = (n, e, μ, p, R_NP row by
+    row, ...)."""
+    R = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            R[i, j] = p[4 + 3 * i + j]
+    lvlh_state(t, p[0], p[1], p[2], p[3], R, g, V, V_dot)
