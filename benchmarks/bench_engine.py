@@ -121,7 +121,7 @@ def breakdown() -> None:
     """Where one call of the one-body tracking case goes (best of 9 batches of 5000)."""
     import timeit
 
-    from gmuk import _uk_kernels
+    from gmuk.engine import _uk_kernels
 
     J = np.diag([3.0e4, 3.2e4, 3.4e4])
     body = gmuk.RigidBody("a", 15103.0, J)
@@ -132,7 +132,7 @@ def breakdown() -> None:
     A, b = S._stack_rows(st, check_finite=False)
     z = S._zero_loads
     args = (st.V, z, A, b, S.solver._params, np.empty(4 * 6 + 6 + 3))
-    compiled = gmuk.solvers._fused_entry()
+    compiled = gmuk.engine.solvers._fused_entry()
     parts = [
         ("System.accelerations (whole call)", lambda: S.accelerations(st)),
         ("reference.evaluate (the user's)", lambda: ref.evaluate(0.3)),

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 import gmuk
-from gmuk.integrate import _Problem
+from gmuk.engine.integrate import _Problem
 from gmuk.orbits import KeplerOrbit, LVLHReference, fcei_orbit
 from gmuk.scenarios import _lvlh as common
 from gmuk.scenarios import fcei
@@ -128,7 +128,7 @@ def fccl_run(python_loop: bool) -> float:
 
     from gmuk.scenarios import fccl
 
-    force = mock.patch("gmuk.system._simulate", _reference)
+    force = mock.patch("gmuk.engine.system._simulate", _reference)
     walls = []
     with force if python_loop else contextlib.nullcontext():
         fccl.run()

@@ -9,22 +9,21 @@ The flow: parts (bodies, constraints, force models, controllers) → :class:`Sys
 :class:`Trajectory`.
 """
 
+import sys as _sys
+
 from gmuk import (
     constraints,
     control,
     crosscheck,
     dynamics,
+    engine,
     errors,
     forces,
     gravity,
-    integrate,
-    integrators,
     kkt,
     lie,
     orbits,
     reference,
-    solvers,
-    uk,
 )
 from gmuk.bodies import Body, BodyKind, PointMass, RigidBody, SlackCoordinate
 from gmuk.celestial import INERTIAL, CelestialBody, UniformRotation
@@ -45,6 +44,10 @@ from gmuk.constraints import (
 from gmuk.control import Controller, MorseLyapunovController
 from gmuk.crosscheck import check
 from gmuk.dynamics import spatial_inertia
+from gmuk.engine import integrate, integrators, solvers, uk
+from gmuk.engine.integrate import compile_loop
+from gmuk.engine.solvers import UKSolver
+from gmuk.engine.system import Accelerations, System
 from gmuk.forces import (
     AppliedWrench,
     ForceModel,
@@ -58,11 +61,8 @@ from gmuk.forces import (
     UniformGravity,
 )
 from gmuk.gravity import SphericalHarmonicField
-from gmuk.integrate import compile_loop
 from gmuk.reference import ReferenceState, ReferenceTrajectory
-from gmuk.solvers import UKSolver
 from gmuk.state import Layout, State
-from gmuk.system import Accelerations, System
 from gmuk.trajectory import BodyTrajectory, Trajectory, load_trajectory
 
 __version__ = "0.1.0"
@@ -117,6 +117,7 @@ __all__ = [
     "control",
     "crosscheck",
     "dynamics",
+    "engine",
     "errors",
     "forces",
     "gravity",
@@ -131,6 +132,12 @@ __all__ = [
     "spatial_inertia",
     "uk",
 ]
+
+# The engine's modules under the names they had before gmuk.engine: the same module objects,
+# so ``import gmuk.system`` and pickles naming ``gmuk.integrate`` keep working.
+for _name in ("integrate", "integrators", "solvers", "system", "uk"):
+    _sys.modules[f"gmuk.{_name}"] = _sys.modules[f"gmuk.engine.{_name}"]
+del _name
 
 #: Submodules imported on first use (they pull in matplotlib, Pinocchio, the CLI or campaigns).
 _LAZY = ("cli", "plotting", "scenarios", "view", "campaign")

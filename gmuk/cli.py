@@ -49,7 +49,7 @@ from typing import Any, NoReturn
 
 from gmuk import runs, scenarios
 from gmuk.errors import GmukError
-from gmuk.integrate import versions
+from gmuk.engine.integrate import versions
 from gmuk.runs import RunControl
 from gmuk.scenarios import OptionError, Scenario
 from gmuk.trajectory import write_text_atomic
@@ -443,7 +443,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "compile":
             import time
 
-            from gmuk.integrators import _compiled
+            from gmuk.engine.integrators import _compiled
 
             start = time.perf_counter()
             was = _compiled.loaded()

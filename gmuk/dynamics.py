@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from gmuk import _uk_kernels
+from gmuk._numba import njit
 from gmuk._validation import NOT_REAL, FloatArray, as_array, check_se3
 from gmuk.errors import InertiaError
 from gmuk.lie import se3
@@ -21,12 +21,41 @@ __all__ = [
     "free_acceleration",
     "g_ddot",
     "kinetic_energy",
+    "rigid_free_accel",
     "spatial_inertia",
     "spatial_momentum",
 ]
 
 #: Relative tolerance for symmetry of J and for the triangle inequalities of its moments.
 INERTIA_TOL = 1e-9
+
+
+@njit(cache=True)
+def rigid_free_accel(
+    V: np.ndarray, J: np.ndarray, Jinv: np.ndarray, m: np.ndarray, Q: np.ndarray
+) -> np.ndarray:
+    """V̇ = 𝕀⁻¹(ad*_V 𝕀 V + Q) for n rigid bodies: (n, 6) twists and wrenches → (n, 6).
+
+    ad*_V 𝕀V = [Jω × ω; m v × ω] (McCann 2020, Eq. 10b, written out).
+    """
+    n = V.shape[0]
+    out = np.empty((n, 6))
+    for k in range(n):
+        w0, w1, w2 = V[k, 0], V[k, 1], V[k, 2]
+        v0, v1, v2 = V[k, 3], V[k, 4], V[k, 5]
+        h0 = J[k, 0, 0] * w0 + J[k, 0, 1] * w1 + J[k, 0, 2] * w2
+        h1 = J[k, 1, 0] * w0 + J[k, 1, 1] * w1 + J[k, 1, 2] * w2
+        h2 = J[k, 2, 0] * w0 + J[k, 2, 1] * w1 + J[k, 2, 2] * w2
+        L0 = h1 * w2 - h2 * w1 + Q[k, 0]
+        L1 = h2 * w0 - h0 * w2 + Q[k, 1]
+        L2 = h0 * w1 - h1 * w0 + Q[k, 2]
+        for i in range(3):
+            out[k, i] = Jinv[k, i, 0] * L0 + Jinv[k, i, 1] * L1 + Jinv[k, i, 2] * L2
+        im = 1.0 / m[k]
+        out[k, 3] = v1 * w2 - v2 * w1 + Q[k, 3] * im
+        out[k, 4] = v2 * w0 - v0 * w2 + Q[k, 4] * im
+        out[k, 5] = v0 * w1 - v1 * w0 + Q[k, 5] * im
+    return out
 
 
 def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatArray]:
@@ -132,7 +161,7 @@ def free_acceleration(V: Any, inertia: Any, wrench: Any = None) -> FloatArray:
         ``V̇ = [ω̇; v̇]`` (rad/s², m/s²): the rate of the body-frame components of V.
         For 𝕀 = blkdiag(J, mI) this is Euler's equation ``J ω̇ = Jω × ω + L`` and
         ``v̇ = v × ω + f/m``, evaluated by the kernel the System and the compiled loop use
-        (:func:`gmuk._uk_kernels.rigid_free_accel`), which writes ad*_V 𝕀V out without the
+        (:func:`rigid_free_accel`), which writes ad*_V 𝕀V out without the
         term m v × v (zero, but of order ε m|v|² when evaluated: 1e-5 N·m for 500 kg at
         7 km/s).
 
@@ -162,7 +191,7 @@ def free_acceleration(V: Any, inertia: Any, wrench: Any = None) -> FloatArray:
     n = int(np.prod(shape))
     # fresh C-contiguous float64 arrays: the types the kernel is compiled for
     J = np.array(np.broadcast_to(I[..., :3, :3], (*shape, 3, 3)), dtype=np.float64).reshape(n, 3, 3)
-    out = _uk_kernels.rigid_free_accel(
+    out = rigid_free_accel(
         np.array(np.broadcast_to(V, (*shape, 6)), dtype=np.float64).reshape(n, 6),
         J,
         np.linalg.inv(J),

@@ -38,7 +38,7 @@ from gmuk.constraints.inequality import InequalityConstraint
 from gmuk.errors import DefinitionError
 
 if TYPE_CHECKING:
-    from gmuk.system import System
+    from gmuk.engine.system import System
     from gmuk.trajectory import Trajectory
 
 __all__ = ["BoundConditions", "InequalityKKT", "KKTDiagnostics", "kkt_diagnostics"]

@@ -1,6 +1,6 @@
 """Stopping, checkpointing and resuming the simulations of a run.
 
-Inside ``with run_control(...)``, every :func:`gmuk.integrate.simulate` call (numbered 0, 1,
+Inside ``with run_control(...)``, every :func:`gmuk.engine.integrate.simulate` call (numbered 0, 1,
 2, … in call order, so a scenario that runs several simulations gets one file each):
 
 * stops at the next step once :meth:`RunControl.request_stop` has been called (a signal

@@ -1,7 +1,7 @@
 """gmuk's reference integrator loop in Python: a test oracle, not a runtime path.
 
-:func:`gmuk.integrate.simulate` runs one loop, the compiled one
-(:mod:`gmuk.integrators._compiled`). This module keeps the same Runge–Kutta–Munthe-Kaas loop
+:func:`gmuk.engine.integrate.simulate` runs one loop, the compiled one
+(:mod:`gmuk.engine.integrators._compiled`). This module keeps the same Runge–Kutta–Munthe-Kaas loop
 written in numpy, statement by statement, with the System's own Python ``accelerations`` as
 the right-hand side and the method object's Python ``stages``, ``error_norm``,
 ``interpolant`` and ``interpolant_error``. Tests compare the two: the compiled loop must
@@ -22,16 +22,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk._validation import FloatArray
+from gmuk.engine.integrate import _Packing, _Recorder, check_run
+from gmuk.engine.integrators import RungeKuttaMethod
+from gmuk.engine.integrators._base import label
 from gmuk.errors import GmukWarning, SimulationError
-from gmuk.integrate import _Packing, _Recorder, check_run
-from gmuk.integrators import RungeKuttaMethod
-from gmuk.integrators._base import label
 from gmuk.lie import _kernels
 from gmuk.state import State
 from gmuk.trajectory import Trajectory
 
 if TYPE_CHECKING:
-    from gmuk.system import Accelerations, System
+    from gmuk.engine.system import Accelerations, System
 
 __all__ = ["StepFailure", "reference_simulate"]
 
@@ -55,7 +55,7 @@ def reference_simulate(
     max_steps: int = 1_000_000,
     on_failure: str = "raise",
 ) -> Trajectory:
-    """:func:`gmuk.integrate.simulate` by the reference Python loop (same arguments, checked
+    """:func:`gmuk.engine.integrate.simulate` by the reference Python loop (same arguments, checked
     the same way; no checkpoints or progress bar). ``stats["compiled"]`` is False."""
     run = check_run(
         system, state0, t_span, t_eval=t_eval, method=method, rtol=rtol, atol=atol, step=step,

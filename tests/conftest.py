@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from gmuk.integrators import _compiled
+from gmuk.engine.integrators import _compiled
 
 
 @pytest.fixture(autouse=True, scope="session")

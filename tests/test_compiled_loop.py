@@ -1,5 +1,5 @@
-"""The compiled step loop (gmuk.integrators._compiled) against the Python loop: every built-in
-part with a compiled form, mixed and ineligible Systems, failures, stops and resumes."""
+"""The compiled step loop (gmuk.engine.integrators._compiled) against the Python loop: every
+built-in part with a compiled form, mixed and ineligible Systems, failures, stops and resumes."""
 
 from __future__ import annotations
 
@@ -14,10 +14,11 @@ import numpy as np
 import pytest
 
 import gmuk
-from gmuk import _numba, integrate, runs, testing
+from gmuk import _numba, runs, testing
+from gmuk.engine import integrate
+from gmuk.engine.integrators import _compiled, get_method
+from gmuk.engine.integrators import _program as program_records
 from gmuk.errors import DefinitionError, SimulationError
-from gmuk.integrators import _compiled, get_method
-from gmuk.integrators import _program as program_records
 from gmuk.testing import reference_simulate
 
 MU = 4.9028e12  # m³/s², the Moon
@@ -888,7 +889,7 @@ def test_every_program_has_the_argument_types_the_loop_is_compiled_for():
 _HOLD_LOCK = """
 import sys, time
 from pathlib import Path
-from gmuk.integrators import _compiled as c
+from gmuk.engine.integrators import _compiled as c
 c._lock_path = lambda: Path(sys.argv[1])
 with c._compile_lock(5.0, False):
     print("held", flush=True)
@@ -942,7 +943,7 @@ def test_a_compilation_waits_for_another_process_compiling_and_loads_its_result(
 def test_a_new_process_loads_the_compiled_loop_from_the_cache_without_compiling():
     assert _compiled.compile_loop()
     code = (
-        "import time; from gmuk.integrators import _compiled as c; t = time.perf_counter(); "
+        "import time; from gmuk.engine.integrators import _compiled as c; t = time.perf_counter(); "
         "ok = c.loaded(); print(ok, time.perf_counter() - t, "
         "sum(c.advance.stats.cache_misses.get(s, 0) for s in c.advance.overloads))"
     )

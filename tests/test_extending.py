@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 import gmuk
-from gmuk import cli, scenarios, solvers
-from gmuk.integrators import RungeKuttaMethod
+from gmuk import cli, scenarios
+from gmuk.engine import solvers
+from gmuk.engine.integrators import RungeKuttaMethod
 from gmuk.scenarios import Option, Scenario, ScenarioResult
 
 # --- a constraint kind ---

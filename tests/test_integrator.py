@@ -107,7 +107,8 @@ def test_dense_error_estimate_bounds_the_interpolation_error_within_a_step():
     # The defect-based estimate (DOP853.interpolant_error) against the true error of the
     # continuous extension over one step, both in the step-error norm: conservative, and by
     # less than a factor 3 (measured 1.55 here and 1.2-1.6 along an elliptic orbit).
-    from gmuk import integrate, testing
+    from gmuk import testing
+    from gmuk.engine import integrate
 
     system, state = free_body((0.9, 2.0, 0.4, 1.0, -0.5, 0.3))
     prob = testing._ReferenceProblem(system)

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import gmuk
-from gmuk import integrate, testing
-from gmuk.errors import DefinitionError
-from gmuk.integrators import (
+from gmuk import testing
+from gmuk.engine import integrate
+from gmuk.engine.integrators import (
     DOP853,
     DOPRI5,
     METHODS,
@@ -20,7 +20,8 @@ from gmuk.integrators import (
     get_method,
     method_names,
 )
-from gmuk.integrators import _dop853_tableau as tab
+from gmuk.engine.integrators import _dop853_tableau as tab
+from gmuk.errors import DefinitionError
 from gmuk.lie import se3
 
 J = np.diag([1.0, 2.0, 3.0])

@@ -8,8 +8,8 @@ import pytest
 from helpers import Rows, ScrewReference, random_rigid_bodies, random_state
 
 import gmuk
-from gmuk import solvers, uk
 from gmuk.bodies import BodyKind
+from gmuk.engine import solvers, uk
 from gmuk.errors import DefinitionError
 
 

@@ -5,7 +5,7 @@ beside its class (:mod:`gmuk.constraints.tracking`, :mod:`gmuk.constraints.relat
 the signature ``kernel(t, g_1, V_1, g_2, V_2, p, A, b) -> status``: the rows A (s, 12), b (s,)
 of the constraint on its first body (columns 0–5) and its second one (columns 6–11; zero and
 ``g_2, V_2`` ignored for a one-body constraint). Its ``rows`` calls the same definition, and the
-compiled loop (:mod:`gmuk.integrators._compiled`) calls it through :func:`apply_rows`, which
+compiled loop (:mod:`gmuk.engine.integrators._compiled`) calls it through :func:`apply_rows`, which
 only dispatches on the code :data:`CODES` gives each kernel. A constraint's
 :meth:`~gmuk.Constraint._compiled_term` finds its code there.
 """

@@ -21,7 +21,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from gmuk import _uk_kernels
 from gmuk._forms import Forms
 from gmuk._numba import njit
 from gmuk._validation import FloatArray
@@ -33,6 +32,76 @@ from gmuk.lie import se3
 if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
+
+
+@njit(cache=True)
+def relative_rows(
+    g_L: np.ndarray,
+    V_L: np.ndarray,
+    g_B: np.ndarray,
+    V_B: np.ndarray,
+    S: np.ndarray,
+    a_des: np.ndarray,
+    A: np.ndarray,
+    b: np.ndarray,
+    Vr: np.ndarray,
+) -> None:
+    """Rows of a relative-twist constraint (McCann 2020, Eq. 73 and Section 4.1.3).
+
+    With h = g_{B/L}⁻¹ = g_B⁻¹ g_L (R_h = R_Bᵀ R_L, p_h = R_Bᵀ (p_L − p_B)),
+    Ad_h = [[R_h, 0], [p_h^ R_h, R_h]], W = Ad_h V_L and V_{B/L} = V_B − W:
+    ``A = [−S Ad_h, S]`` and ``b = S (a_des − ad_{V_{B/L}} W)``, with
+    ``ad_V W = [ω × ω_W; v × ω_W + ω × v_W]``. Writes A (s, 12), b (s,) and V_{B/L} (6,)
+    into the arrays given.
+    """
+    Rh = np.empty((3, 3))
+    d = np.empty(3)
+    for k in range(3):
+        d[k] = g_L[k, 3] - g_B[k, 3]
+    ph = np.empty(3)
+    for i in range(3):
+        ph[i] = g_B[0, i] * d[0] + g_B[1, i] * d[1] + g_B[2, i] * d[2]
+        for j in range(3):
+            Rh[i, j] = g_B[0, i] * g_L[0, j] + g_B[1, i] * g_L[1, j] + g_B[2, i] * g_L[2, j]
+    Ad = np.zeros((6, 6))
+    for i in range(3):
+        for j in range(3):
+            Ad[i, j] = Rh[i, j]
+            Ad[3 + i, 3 + j] = Rh[i, j]
+    for j in range(3):  # p_h × (column j of R_h)
+        c0, c1, c2 = Rh[0, j], Rh[1, j], Rh[2, j]
+        Ad[3, j] = ph[1] * c2 - ph[2] * c1
+        Ad[4, j] = ph[2] * c0 - ph[0] * c2
+        Ad[5, j] = ph[0] * c1 - ph[1] * c0
+    W = np.empty(6)
+    for i in range(6):
+        acc = 0.0
+        for k in range(6):
+            acc += Ad[i, k] * V_L[k]
+        W[i] = acc
+    for i in range(6):
+        Vr[i] = V_B[i] - W[i]
+    w0, w1, w2, v0, v1, v2 = Vr[0], Vr[1], Vr[2], Vr[3], Vr[4], Vr[5]
+    x0, x1, x2, y0, y1, y2 = W[0], W[1], W[2], W[3], W[4], W[5]
+    r = np.empty(6)
+    r[0] = a_des[0] - (w1 * x2 - w2 * x1)
+    r[1] = a_des[1] - (w2 * x0 - w0 * x2)
+    r[2] = a_des[2] - (w0 * x1 - w1 * x0)
+    r[3] = a_des[3] - (v1 * x2 - v2 * x1 + w1 * y2 - w2 * y1)
+    r[4] = a_des[4] - (v2 * x0 - v0 * x2 + w2 * y0 - w0 * y2)
+    r[5] = a_des[5] - (v0 * x1 - v1 * x0 + w0 * y1 - w1 * y0)
+    s = S.shape[0]
+    for i in range(s):
+        acc_b = 0.0
+        for j in range(6):
+            acc = 0.0
+            for k in range(6):
+                acc += S[i, k] * Ad[k, j]
+            A[i, j] = -acc
+            A[i, 6 + j] = S[i, j]
+            acc_b += S[i, j] * r[j]
+        b[i] = acc_b
+
 
 __all__ = ["RelativeConstraint", "relative_constraint_rows", "relative_loop_rows", "relative_twist"]
 
@@ -46,7 +115,7 @@ def relative_constraint_rows(gL, VL, gB, VB, S, a_des, alpha, v_des, A, b):  # t
     ``S V̇_{B/L} = S a_des`` (module docstring), minus ``α_i (S (V_{B/L} − v_des))_i`` on each
     row with a Baumgarte gain α_i ≠ 0. The one definition of :meth:`RelativeConstraint.rows`."""
     V_BL = np.empty(6)
-    _uk_kernels.relative_rows(gL, VL, gB, VB, S, a_des, A, b, V_BL)
+    relative_rows(gL, VL, gB, VB, S, a_des, A, b, V_BL)
     for a in range(S.shape[0]):
         if alpha[a] != 0.0:
             q = 0.0

@@ -3,7 +3,7 @@
 For n rigid bodies, ``g̈ = blkdiag(g̈₁, …, g̈ₙ)`` (4n × 4n), ``A`` is (m, 4n), ``B`` (4n, p) and
 ``C`` (m, p). Every reachable g̈ is ``g̈_i = g_i (V_i^² + V̇_i^)``, so the constraint is linear
 in the body accelerations: :meth:`TangentBundleConstraint.rows` gives those rows
-(:func:`gmuk.uk.reachable_rows`), which the System stacks and solves like any other
+(:func:`gmuk.engine.uk.reachable_rows`), which the System stacks and solves like any other
 constraint's. With ``System(..., tangent_bundle_method="eq80")`` the System instead solves
 Eq. 80 for ``g̈_c`` and recovers ``V̇_c,i = (g_i⁻¹ g̈_c,ii)^∨``. Errata (docs/errata.rst):
 for general A, B the g̈_c of Eq. 80 need not lie in g·se(3) (no control input produces it);
@@ -22,10 +22,10 @@ from gmuk._forms import Forms
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Constraint
+from gmuk.engine.uk import reachable_rows
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3
 from gmuk.reference import ReferenceTrajectory
-from gmuk.uk import reachable_rows
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body
@@ -56,7 +56,7 @@ class TangentBundleConstraint(Constraint):
         -------
         A6 : ndarray (m·p, 6k)
         b6 : ndarray (m·p,)
-            See :func:`gmuk.uk.reachable_rows`.
+            See :func:`gmuk.engine.uk.reachable_rows`.
         """
         A, B, C = (np.asarray(x, dtype=float) for x in self.tangent_rows(state))
         idx = list(self._rigid_indices(state))

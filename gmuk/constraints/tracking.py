@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gmuk import _uk_kernels
 from gmuk._forms import Forms
 from gmuk._numba import njit
 from gmuk._validation import FloatArray
@@ -28,6 +27,67 @@ from gmuk.reference import ReferenceTrajectory
 if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
+
+
+@njit(cache=True, inline="always")
+def _hat4(x: np.ndarray, M: np.ndarray) -> None:
+    M[0, 0] = M[1, 1] = M[2, 2] = 0.0
+    M[0, 1], M[0, 2], M[1, 2] = -x[2], x[1], -x[0]
+    M[1, 0], M[2, 0], M[2, 1] = x[2], -x[1], x[0]
+    M[0, 3], M[1, 3], M[2, 3] = x[3], x[4], x[5]
+    M[3, 0] = M[3, 1] = M[3, 2] = M[3, 3] = 0.0
+
+
+@njit(cache=True, inline="always")
+def _mul4(A: np.ndarray, B: np.ndarray, out: np.ndarray) -> None:
+    for i in range(4):
+        for j in range(4):
+            out[i, j] = (
+                A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j] + A[i, 3] * B[3, j]
+            )
+
+
+@njit(cache=True)
+def tracking_b(
+    g: np.ndarray,
+    V: np.ndarray,
+    gd: np.ndarray,
+    Vd: np.ndarray,
+    Vd_dot: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """b of Eq. 67, projected: se(3) part of g⁻¹ g_d (V_d^² + V̇_d^) − V^² as a twist,
+    written into ``out`` (6,).
+
+    Explicit 4×4 loops: BLAS calls on such small matrices cost more than the arithmetic.
+    """
+    H = np.empty((4, 4))
+    Hd = np.empty((4, 4))
+    T1 = np.empty((4, 4))
+    T2 = np.empty((4, 4))
+    ginv = np.zeros((4, 4))
+    for i in range(3):
+        for j in range(3):
+            ginv[i, j] = g[j, i]
+        ginv[i, 3] = -(g[0, i] * g[0, 3] + g[1, i] * g[1, 3] + g[2, i] * g[2, 3])
+    ginv[3, 3] = 1.0
+    _hat4(Vd, Hd)
+    _mul4(Hd, Hd, T1)  # V_d^²
+    _hat4(Vd_dot, H)
+    for i in range(4):
+        for j in range(4):
+            T1[i, j] += H[i, j]  # V_d^² + V̇_d^
+    _mul4(ginv, gd, T2)  # g⁻¹ g_d
+    _mul4(T2, T1, Hd)  # g⁻¹ g_d (V_d^² + V̇_d^)
+    _hat4(V, H)
+    _mul4(H, H, T1)  # V^²
+    out[0] = 0.5 * ((Hd[2, 1] - T1[2, 1]) - (Hd[1, 2] - T1[1, 2]))
+    out[1] = 0.5 * ((Hd[0, 2] - T1[0, 2]) - (Hd[2, 0] - T1[2, 0]))
+    out[2] = 0.5 * ((Hd[1, 0] - T1[1, 0]) - (Hd[0, 1] - T1[0, 1]))
+    out[3] = Hd[0, 3] - T1[0, 3]
+    out[4] = Hd[1, 3] - T1[1, 3]
+    out[5] = Hd[2, 3] - T1[2, 3]
+
 
 __all__ = [
     "ConfigurationTracking",
@@ -133,7 +193,7 @@ def tracking_rows(g, V, gd, Vd, Vd_dot, baumgarte, alpha, beta, b):  # type: ign
     """b (6,) of configuration tracking (A = I₆): Eq. 67 projected onto se(3), minus
     ``α e_V + β e_g`` row by row when ``baumgarte`` (gains α, β (6,); errors of
     :func:`tracking_errors`). The one definition of :meth:`ConfigurationTracking.rows`."""
-    _uk_kernels.tracking_b(g, V, gd, Vd, Vd_dot, b)
+    tracking_b(g, V, gd, Vd, Vd_dot, b)
     if baumgarte:
         e_g = np.empty(6)
         e_V = np.empty(6)

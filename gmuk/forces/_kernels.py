@@ -3,7 +3,7 @@
 Each built-in model's formula is written once, as a numba kernel beside its class
 (:mod:`gmuk.forces.gravity`, :mod:`gmuk.forces.mechanical`), with the signature
 ``kernel(rigid, t, g, V, m, J, p, field, out) -> status``; the model's ``wrench``/``force``
-call it, and the compiled loop (:mod:`gmuk.integrators._compiled`) calls it through
+call it, and the compiled loop (:mod:`gmuk.engine.integrators._compiled`) calls it through
 :func:`apply_term`, which only dispatches on the code that :data:`CODES` gives each kernel.
 A model's :meth:`~gmuk.forces.ForceModel._compiled_term` finds its code there; adding a model
 with a compiled form adds its kernel to :data:`CODES` and one branch to :func:`apply_term`.

@@ -68,7 +68,7 @@ from gmuk.optimize.result import OptimalControlResult, PathConstraintResult, Ref
 from gmuk.state import State
 
 if TYPE_CHECKING:
-    from gmuk.system import System
+    from gmuk.engine.system import System
 
 __all__ = ["OptimalControlProblem"]
 
@@ -139,7 +139,7 @@ class OptimalControlProblem:
         cost: CostFunction | None = None,
         max_element_rotation: float = 1.5,
     ) -> None:
-        from gmuk.system import System
+        from gmuk.engine.system import System
 
         casadi()  # CasADi is installed, or a MissingDependencyError with the pip command
         if not isinstance(system, System):

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gmuk.integrators._base import RungeKuttaMethod
+from gmuk.engine.integrators._base import RungeKuttaMethod
 
 __all__ = ["DOPRI5"]
 

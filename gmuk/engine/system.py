@@ -22,7 +22,6 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from gmuk import _uk_kernels, solvers, uk
 from gmuk._validation import (
     FloatArray,
     all_finite,
@@ -34,16 +33,17 @@ from gmuk._validation import (
 from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
 from gmuk.control.base import Controller
+from gmuk.engine import _uk_kernels, solvers, uk
+from gmuk.engine.integrate import simulate as _simulate
+from gmuk.engine.integrators import _program
+from gmuk.engine.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
 from gmuk.errors import ConstraintError, DefinitionError, NonFiniteError
 from gmuk.forces.base import ForceModel
-from gmuk.integrate import simulate as _simulate
-from gmuk.integrators import _program
-from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
 from gmuk.state import Layout, State
 
 if TYPE_CHECKING:
-    from gmuk.integrators import RungeKuttaMethod
-    from gmuk.integrators._program import Program
+    from gmuk.engine.integrators import RungeKuttaMethod
+    from gmuk.engine.integrators._program import Program
     from gmuk.trajectory import Trajectory
 
 __all__ = ["QR_COND_LIMIT", "QR_MAX_ROWS", "SPARSE_THRESHOLD", "Accelerations", "System"]
@@ -63,7 +63,7 @@ class System:
     forces : sequence of ForceModel
     controllers : sequence of Controller
     solver : str or UKSolver subclass, optional
-        The Udwadia–Kalaba solve strategy (:mod:`gmuk.solvers`): "fused", "dense",
+        The Udwadia–Kalaba solve strategy (:mod:`gmuk.engine.solvers`): "fused", "dense",
         "sparse", "eq80", or any registered name or subclass. Default: chosen from
         ``sparse`` and ``tangent_bundle_method`` — "eq80" when asked for, "sparse" when
         ``sparse`` is True (or "auto" above ``SPARSE_THRESHOLD`` dof), else "fused" when the
@@ -73,11 +73,11 @@ class System:
     sparse_solver : {"lu", "cg"}
         Sparse solve of A M⁻¹ Aᵀ λ = r: direct LU (exact; best for chain- or mesh-like
         coupling) or conjugate gradients (best for large, randomly coupled systems); see
-        :func:`gmuk.uk.solve_sparse`.
+        :func:`gmuk.engine.uk.solve_sparse`.
     tangent_bundle_method : {"reachable", "eq80"}
         How a :class:`~gmuk.constraints.TangentBundleConstraint` is solved. "reachable"
         (default): its rows restrict ``A g̈ B = C`` to reachable accelerations
-        ``g(V^² + V̇^)`` (:func:`gmuk.uk.reachable_rows`) and stack with any other
+        ``g(V^² + V̇^)`` (:func:`gmuk.engine.uk.reachable_rows`) and stack with any other
         constraint's rows. "eq80": McCann (2020) Eq. 80 as printed, each body's block of
         g̈_c projected onto g·se(3) (``Accelerations.unreachable`` says how much it
         discarded); the System then takes that one constraint only. They agree for full
@@ -725,7 +725,7 @@ class System:
     # ------------------------------------------------------------------ compiled form
     def compiled_program(self, method: RungeKuttaMethod, state: State) -> Program:
         """This System's compiled form with ``method`` for a run from ``state``: the arrays
-        and the Python callback the compiled loop runs (:mod:`gmuk.integrators._program`).
+        and the Python callback the compiled loop runs (:mod:`gmuk.engine.integrators._program`).
 
         Each part contributes what it declares (its ``_compiled_term``; parts without one are
         called back in Python), and the solve runs compiled under the ``"fused"`` and
@@ -779,7 +779,7 @@ class System:
 
     @property
     def compiled_solve(self) -> tuple[int, str]:
-        """How the compiled loop solves this System (``gmuk.integrators._program``'s FREE,
+        """How the compiled loop solves this System (``gmuk.engine.integrators._program``'s FREE,
         FUSED, DENSE or PYTHON_SOLVE) and, for PYTHON_SOLVE, why."""
         if type(self).accelerations is not System.accelerations:
             return _program.PYTHON_SOLVE, "the System subclass has its own accelerations"
@@ -793,7 +793,7 @@ class System:
 
     # ------------------------------------------------------------------ simulation
     def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:
-        """Integrate from ``state0`` over ``t_span``; see :func:`gmuk.integrate.simulate`."""
+        """Integrate from ``state0`` over ``t_span``; see :func:`gmuk.engine.integrate.simulate`."""
         return _simulate(self, state0, t_span, **options)
 
     def __repr__(self) -> str:

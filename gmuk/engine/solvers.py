@@ -18,7 +18,8 @@ Built in (names for ``System(..., solver=NAME)``):
 ``"dense"`` (:class:`DenseSolver`)
     QR when full row rank is certified, else the SVD (minimum-norm, rank-revealing).
 ``"sparse"`` (:class:`SparseSolver`)
-    Sparse rows; A M⁻¹ Aᵀ λ = r by SuperLU or conjugate gradients (:func:`gmuk.uk.solve_sparse`).
+    Sparse rows; A M⁻¹ Aᵀ λ = r by SuperLU or conjugate gradients
+    (:func:`gmuk.engine.uk.solve_sparse`).
 ``"eq80"`` (:class:`TangentBundleEq80Solver`)
     McCann (2020) Eq. 80 as printed for one :class:`~gmuk.constraints.TangentBundleConstraint`,
     with each body's block of g̈_c projected onto g·se(3).
@@ -39,10 +40,10 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from gmuk import _uk_kernels, uk
 from gmuk._validation import FloatArray, all_finite
 from gmuk.bodies import Body, RigidBody
 from gmuk.constraints.tangent_bundle import TangentBundleConstraint
+from gmuk.engine import _uk_kernels, uk
 from gmuk.errors import (
     ConstraintError,
     DefinitionError,
@@ -53,8 +54,8 @@ from gmuk.lie import se3
 from gmuk.state import Layout
 
 if TYPE_CHECKING:
+    from gmuk.engine.system import System
     from gmuk.state import State
-    from gmuk.system import System
 
 __all__ = [
     "QR_COND_LIMIT",
@@ -76,8 +77,8 @@ QR_COND_LIMIT = 1e8
 _EPS = float(np.finfo(float).eps)
 _F64 = np.dtype(np.float64)
 _empty = np.empty
-#: The compiled entry of :func:`gmuk._uk_kernels.uk_rigid` for its one shared signature
-#: (:data:`gmuk._uk_kernels.UK_RIGID_SIGNATURE`, the compiled loop's argument types), made by
+#: The compiled entry of :func:`gmuk.engine._uk_kernels.uk_rigid` for its one shared signature
+#: (:data:`gmuk.engine._uk_kernels.UK_RIGID_SIGNATURE`, the compiled loop's argument types), made by
 #: :func:`_fused_entry` when the first System that takes the fused solve is built (not on
 #: import).
 _uk_rigid_c: Any = None
@@ -463,7 +464,8 @@ class FusedRigidSolver(DenseSolver):
 
 class SparseSolver(UKSolver):
     """Sparse rows (CSR): ``A M⁻¹ Aᵀ λ = b − A a`` by SuperLU (``method="lu"``) or by
-    Jacobi-preconditioned conjugate gradients (``"cg"``); see :func:`gmuk.uk.solve_sparse`."""
+    Jacobi-preconditioned conjugate gradients (``"cg"``); see
+    :func:`gmuk.engine.uk.solve_sparse`."""
 
     name = "sparse"
     sparse = True
@@ -547,6 +549,6 @@ def resolve(solver: object) -> type[UKSolver]:
     if isinstance(solver, str) and solver in SOLVERS:
         return SOLVERS[solver]
     raise DefinitionError(
-        f"solver must be one of {sorted(SOLVERS)} or a gmuk.solvers.UKSolver subclass; "
+        f"solver must be one of {sorted(SOLVERS)} or a gmuk.engine.solvers.UKSolver subclass; "
         f"got {solver!r}"
     )

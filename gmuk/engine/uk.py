@@ -18,8 +18,8 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from gmuk import _uk_kernels
 from gmuk._validation import FloatArray
+from gmuk.engine import _uk_kernels
 from gmuk.lie import se3
 
 __all__ = [

@@ -16,37 +16,10 @@ import numpy as np
 from numba import types
 
 from gmuk._numba import njit
+from gmuk.dynamics import rigid_free_accel
 
 _RW1 = types.Array(types.float64, 1, "C")
 _RW2 = types.Array(types.float64, 2, "C")
-
-
-@njit(cache=True)
-def rigid_free_accel(
-    V: np.ndarray, J: np.ndarray, Jinv: np.ndarray, m: np.ndarray, Q: np.ndarray
-) -> np.ndarray:
-    """V̇ = 𝕀⁻¹(ad*_V 𝕀 V + Q) for n rigid bodies: (n, 6) twists and wrenches → (n, 6).
-
-    ad*_V 𝕀V = [Jω × ω; m v × ω] (McCann 2020, Eq. 10b, written out).
-    """
-    n = V.shape[0]
-    out = np.empty((n, 6))
-    for k in range(n):
-        w0, w1, w2 = V[k, 0], V[k, 1], V[k, 2]
-        v0, v1, v2 = V[k, 3], V[k, 4], V[k, 5]
-        h0 = J[k, 0, 0] * w0 + J[k, 0, 1] * w1 + J[k, 0, 2] * w2
-        h1 = J[k, 1, 0] * w0 + J[k, 1, 1] * w1 + J[k, 1, 2] * w2
-        h2 = J[k, 2, 0] * w0 + J[k, 2, 1] * w1 + J[k, 2, 2] * w2
-        L0 = h1 * w2 - h2 * w1 + Q[k, 0]
-        L1 = h2 * w0 - h0 * w2 + Q[k, 1]
-        L2 = h0 * w1 - h1 * w0 + Q[k, 2]
-        for i in range(3):
-            out[k, i] = Jinv[k, i, 0] * L0 + Jinv[k, i, 1] * L1 + Jinv[k, i, 2] * L2
-        im = 1.0 / m[k]
-        out[k, 3] = v1 * w2 - v2 * w1 + Q[k, 3] * im
-        out[k, 4] = v2 * w0 - v0 * w2 + Q[k, 4] * im
-        out[k, 5] = v0 * w1 - v1 * w0 + Q[k, 5] * im
-    return out
 
 
 @njit(cache=True)
@@ -74,66 +47,6 @@ def uk_dense(
     ac = Minv_sqrt @ y
     res = A @ (a + ac) - b
     return ac, lam, rank, np.sqrt(np.sum(res * res)), np.sqrt(np.sum(Aa * Aa))
-
-
-@njit(cache=True, inline="always")
-def _hat4(x: np.ndarray, M: np.ndarray) -> None:
-    M[0, 0] = M[1, 1] = M[2, 2] = 0.0
-    M[0, 1], M[0, 2], M[1, 2] = -x[2], x[1], -x[0]
-    M[1, 0], M[2, 0], M[2, 1] = x[2], -x[1], x[0]
-    M[0, 3], M[1, 3], M[2, 3] = x[3], x[4], x[5]
-    M[3, 0] = M[3, 1] = M[3, 2] = M[3, 3] = 0.0
-
-
-@njit(cache=True, inline="always")
-def _mul4(A: np.ndarray, B: np.ndarray, out: np.ndarray) -> None:
-    for i in range(4):
-        for j in range(4):
-            out[i, j] = (
-                A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j] + A[i, 3] * B[3, j]
-            )
-
-
-@njit(cache=True)
-def tracking_b(
-    g: np.ndarray,
-    V: np.ndarray,
-    gd: np.ndarray,
-    Vd: np.ndarray,
-    Vd_dot: np.ndarray,
-    out: np.ndarray,
-) -> None:
-    """b of Eq. 67, projected: se(3) part of g⁻¹ g_d (V_d^² + V̇_d^) − V^² as a twist,
-    written into ``out`` (6,).
-
-    Explicit 4×4 loops: BLAS calls on such small matrices cost more than the arithmetic.
-    """
-    H = np.empty((4, 4))
-    Hd = np.empty((4, 4))
-    T1 = np.empty((4, 4))
-    T2 = np.empty((4, 4))
-    ginv = np.zeros((4, 4))
-    for i in range(3):
-        for j in range(3):
-            ginv[i, j] = g[j, i]
-        ginv[i, 3] = -(g[0, i] * g[0, 3] + g[1, i] * g[1, 3] + g[2, i] * g[2, 3])
-    ginv[3, 3] = 1.0
-    _hat4(Vd, Hd)
-    _mul4(Hd, Hd, T1)  # V_d^²
-    _hat4(Vd_dot, H)
-    for i in range(4):
-        for j in range(4):
-            T1[i, j] += H[i, j]  # V_d^² + V̇_d^
-    _mul4(ginv, gd, T2)  # g⁻¹ g_d
-    _mul4(T2, T1, Hd)  # g⁻¹ g_d (V_d^² + V̇_d^)
-    _hat4(V, H)
-    _mul4(H, H, T1)  # V^²
-    out[0] = 0.5 * ((Hd[2, 1] - T1[2, 1]) - (Hd[1, 2] - T1[1, 2]))
-    out[1] = 0.5 * ((Hd[0, 2] - T1[0, 2]) - (Hd[2, 0] - T1[2, 0]))
-    out[2] = 0.5 * ((Hd[1, 0] - T1[1, 0]) - (Hd[0, 1] - T1[0, 1]))
-    out[3] = Hd[0, 3] - T1[0, 3]
-    out[4] = Hd[1, 3] - T1[1, 3]
-    out[5] = Hd[2, 3] - T1[2, 3]
 
 
 @njit(cache=True)
@@ -370,72 +283,3 @@ def uk_rigid(
 #: The signature of :func:`uk_rigid` that the compiled loop calls and the System's fused
 #: solve calls through its compiled entry (writable C-contiguous float64 arrays): one compile.
 UK_RIGID_SIGNATURE = types.void(_RW2, _RW1, _RW2, _RW1, _RW1, _RW1)
-
-
-@njit(cache=True)
-def relative_rows(
-    g_L: np.ndarray,
-    V_L: np.ndarray,
-    g_B: np.ndarray,
-    V_B: np.ndarray,
-    S: np.ndarray,
-    a_des: np.ndarray,
-    A: np.ndarray,
-    b: np.ndarray,
-    Vr: np.ndarray,
-) -> None:
-    """Rows of a relative-twist constraint (McCann 2020, Eq. 73 and Section 4.1.3).
-
-    With h = g_{B/L}⁻¹ = g_B⁻¹ g_L (R_h = R_Bᵀ R_L, p_h = R_Bᵀ (p_L − p_B)),
-    Ad_h = [[R_h, 0], [p_h^ R_h, R_h]], W = Ad_h V_L and V_{B/L} = V_B − W:
-    ``A = [−S Ad_h, S]`` and ``b = S (a_des − ad_{V_{B/L}} W)``, with
-    ``ad_V W = [ω × ω_W; v × ω_W + ω × v_W]``. Writes A (s, 12), b (s,) and V_{B/L} (6,)
-    into the arrays given.
-    """
-    Rh = np.empty((3, 3))
-    d = np.empty(3)
-    for k in range(3):
-        d[k] = g_L[k, 3] - g_B[k, 3]
-    ph = np.empty(3)
-    for i in range(3):
-        ph[i] = g_B[0, i] * d[0] + g_B[1, i] * d[1] + g_B[2, i] * d[2]
-        for j in range(3):
-            Rh[i, j] = g_B[0, i] * g_L[0, j] + g_B[1, i] * g_L[1, j] + g_B[2, i] * g_L[2, j]
-    Ad = np.zeros((6, 6))
-    for i in range(3):
-        for j in range(3):
-            Ad[i, j] = Rh[i, j]
-            Ad[3 + i, 3 + j] = Rh[i, j]
-    for j in range(3):  # p_h × (column j of R_h)
-        c0, c1, c2 = Rh[0, j], Rh[1, j], Rh[2, j]
-        Ad[3, j] = ph[1] * c2 - ph[2] * c1
-        Ad[4, j] = ph[2] * c0 - ph[0] * c2
-        Ad[5, j] = ph[0] * c1 - ph[1] * c0
-    W = np.empty(6)
-    for i in range(6):
-        acc = 0.0
-        for k in range(6):
-            acc += Ad[i, k] * V_L[k]
-        W[i] = acc
-    for i in range(6):
-        Vr[i] = V_B[i] - W[i]
-    w0, w1, w2, v0, v1, v2 = Vr[0], Vr[1], Vr[2], Vr[3], Vr[4], Vr[5]
-    x0, x1, x2, y0, y1, y2 = W[0], W[1], W[2], W[3], W[4], W[5]
-    r = np.empty(6)
-    r[0] = a_des[0] - (w1 * x2 - w2 * x1)
-    r[1] = a_des[1] - (w2 * x0 - w0 * x2)
-    r[2] = a_des[2] - (w0 * x1 - w1 * x0)
-    r[3] = a_des[3] - (v1 * x2 - v2 * x1 + w1 * y2 - w2 * y1)
-    r[4] = a_des[4] - (v2 * x0 - v0 * x2 + w2 * y0 - w0 * y2)
-    r[5] = a_des[5] - (v0 * x1 - v1 * x0 + w0 * y1 - w1 * y0)
-    s = S.shape[0]
-    for i in range(s):
-        acc_b = 0.0
-        for j in range(6):
-            acc = 0.0
-            for k in range(6):
-                acc += S[i, k] * Ad[k, j]
-            A[i, j] = -acc
-            A[i, 6 + j] = S[i, j]
-            acc_b += S[i, j] * r[j]
-        b[i] = acc_b

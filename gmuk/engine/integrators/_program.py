@@ -3,10 +3,10 @@
 :meth:`gmuk.System.compiled_program` describes itself to :func:`build` as a :class:`SystemView`
 (its parts, masses, solve and callbacks) and :func:`build` packs it, with the method's
 :class:`MethodTable`, into a :class:`Program`: named records of arrays that the loop
-(:mod:`gmuk.integrators._compiled`) reads, and :class:`PythonParts`, the C callback through which
-the loop evaluates what has no compiled form. Each part contributes what it declares (a force
-model's ``_compiled_term``, a constraint's, a controller's; ``docs/architecture.rst``); nothing
-here tests a part's class.
+(:mod:`gmuk.engine.integrators._compiled`) reads, and :class:`PythonParts`, the C callback
+through which the loop evaluates what has no compiled form. Each part contributes what it
+declares (a force model's ``_compiled_term``, a constraint's, a controller's;
+``docs/architecture.rst``); nothing here tests a part's class.
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from gmuk.bodies import Body, BodyKind
+from gmuk.engine.integrators._base import RungeKuttaMethod
+from gmuk.engine.integrators.dop853 import DOP853
 from gmuk.errors import ConstraintError, DefinitionError
-from gmuk.integrators._base import RungeKuttaMethod
-from gmuk.integrators.dop853 import DOP853
 
 if TYPE_CHECKING:
     from gmuk.state import Layout, State
@@ -283,7 +283,7 @@ def build(view: SystemView, method: RungeKuttaMethod, state: State) -> Program:
         Whatever a part raises when its rows are evaluated at ``state`` (the caller reports
         it as the run's failure at the start).
     """
-    from gmuk.solvers import QR_COND_LIMIT, QR_MAX_ROWS
+    from gmuk.engine.solvers import QR_COND_LIMIT, QR_MAX_ROWS
 
     meth = method_table(method)
     lay = view.layout
@@ -599,7 +599,7 @@ def _constraint_program(view: SystemView, solve: int) -> tuple[np.ndarray, np.nd
     parameters, the solve's packed constants) for the FREE, FUSED or DENSE solve. The row
     counts of PYTHON constraints and every constraint's first row are left to
     :func:`program`."""
-    from gmuk.solvers import QR_COND_LIMIT
+    from gmuk.engine.solvers import QR_COND_LIMIT
 
     if solve == FREE:
         return np.zeros((0, 6), dtype=np.int64), np.zeros(1), np.zeros(1)

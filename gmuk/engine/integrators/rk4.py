@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gmuk.integrators._base import RungeKuttaMethod
+from gmuk.engine.integrators._base import RungeKuttaMethod
 
 __all__ = ["RK4"]
 

@@ -10,12 +10,14 @@ states. The step ends with ``G₁ = G₀ exp(ξ₁^)``, so poses stay on SE(3) b
 one Newton–Schulz iteration ``R ← R (3I − RᵀR)/2`` per step removes round-off drift, keeping
 ‖RᵀR − I‖ at the 1e-16 level over any number of steps.
 
-The Runge–Kutta method is an object (:mod:`gmuk.integrators`):
-:class:`~gmuk.integrators.DOP853` (default; Dormand–Prince 8(5,3), adaptive, with a continuous
+The Runge–Kutta method is an object (:mod:`gmuk.engine.integrators`):
+:class:`~gmuk.engine.integrators.DOP853`
+(default; Dormand–Prince 8(5,3), adaptive, with a continuous
 extension of order 7 for output times whose error is controlled too),
-:class:`~gmuk.integrators.DOPRI5` (Dormand–Prince 5(4), adaptive, stepping exactly onto output
-times) and :class:`~gmuk.integrators.RK4` (classical, fixed step). :func:`simulate` accepts a
-registered name (case-insensitive), a :class:`~gmuk.integrators.RungeKuttaMethod` subclass or
+:class:`~gmuk.engine.integrators.DOPRI5` (Dormand–Prince 5(4), adaptive, stepping exactly onto
+output
+times) and :class:`~gmuk.engine.integrators.RK4` (classical, fixed step). :func:`simulate` accepts a
+registered name (case-insensitive), a :class:`~gmuk.engine.integrators.RungeKuttaMethod` subclass or
 an instance; a subclass with a ``name`` registers itself.
 
 Error weights follow one rule for the whole state: every 3-vector is weighed by its
@@ -45,24 +47,24 @@ import numpy as np
 
 from gmuk import runs
 from gmuk._validation import FloatArray, real_number
-from gmuk.errors import DefinitionError, GmukError, GmukWarning, SimulationError
 
 # The method classes and the registry, re-exported here for convenience.
-from gmuk.integrators import DOP853 as DOP853
-from gmuk.integrators import DOPRI5 as DOPRI5
-from gmuk.integrators import METHODS as METHODS
-from gmuk.integrators import RK4 as RK4
-from gmuk.integrators import RungeKuttaMethod as RungeKuttaMethod
-from gmuk.integrators import _compiled, _program
-from gmuk.integrators import get_method as get_method
-from gmuk.integrators import method_names as method_names
-from gmuk.integrators._base import label
+from gmuk.engine.integrators import DOP853 as DOP853
+from gmuk.engine.integrators import DOPRI5 as DOPRI5
+from gmuk.engine.integrators import METHODS as METHODS
+from gmuk.engine.integrators import RK4 as RK4
+from gmuk.engine.integrators import RungeKuttaMethod as RungeKuttaMethod
+from gmuk.engine.integrators import _compiled, _program
+from gmuk.engine.integrators import get_method as get_method
+from gmuk.engine.integrators import method_names as method_names
+from gmuk.engine.integrators._base import label
+from gmuk.errors import DefinitionError, GmukError, GmukWarning, SimulationError
 from gmuk.lie import _kernels
 from gmuk.state import State
 from gmuk.trajectory import _ARRAYS, Trajectory
 
 if TYPE_CHECKING:
-    from gmuk.system import Accelerations, System
+    from gmuk.engine.system import Accelerations, System
 
 __all__ = ["METHODS", "compile_loop", "simulate", "versions"]
 
@@ -244,7 +246,7 @@ def simulate(
     t_eval : array_like, shape (k,), optional
         Output times (s) within t_span (increasing). Default: every accepted step.
     method : str, RungeKuttaMethod subclass or instance
-        The Runge–Kutta method (:mod:`gmuk.integrators`): a registered name,
+        The Runge–Kutta method (:mod:`gmuk.engine.integrators`): a registered name,
         case-insensitive — ``"DOP853"`` (default), ``"DOPRI5"``, ``"RK4"`` or any name a
         user subclass registered (see :data:`METHODS`) — or a class or an instance.
     rtol, atol : float
@@ -275,7 +277,7 @@ def simulate(
         the trajectory so far with ``status="interrupted"`` (and a warning).
     compiled : bool, optional
         Deprecated and ignored: every run takes gmuk's one loop, compiled
-        (:mod:`gmuk.integrators._compiled`). Built-in force models, the LVLH tracking and
+        (:mod:`gmuk.engine.integrators._compiled`). Built-in force models, the LVLH tracking and
         relative constraints and the Morse–Lyapunov law run compiled; any other force model,
         constraint, controller or solve strategy is called back in Python from inside the loop
         and costs only its own Python. ``compiled=False`` raises a DefinitionError (the
@@ -505,12 +507,12 @@ def versions() -> dict[str, str]:
 
 
 #: The loop's output buffers: times, states Y, base poses and the right-hand side's other
-#: outputs (gmuk.integrators._program.aux_layout), one row per output.
+#: outputs (gmuk.engine.integrators._program.aux_layout), one row per output.
 _Buffers = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
 
 
 class _Loop:
-    """Drives the compiled loop (:func:`gmuk.integrators._compiled.advance`) in chunks of
+    """Drives the compiled loop (:func:`gmuk.engine.integrators._compiled.advance`) in chunks of
     steps; between chunks Python drains the outputs, updates the progress bar, sees stop
     requests and writes checkpoints. A failure is raised with the trajectory so far kept in
     the recorder; nothing is ever retried by another loop."""

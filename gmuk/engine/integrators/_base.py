@@ -23,12 +23,12 @@ class RungeKuttaMethod:
     """An explicit Runge–Kutta method: its Butcher tableau and its method-specific behaviour.
 
     gmuk applies the method to the local problem of each Runge–Kutta–Munthe-Kaas step
-    (exponential coordinates about the step's base poses, see :mod:`gmuk.integrate`), which
+    (exponential coordinates about the step's base poses, see :mod:`gmuk.engine.integrate`), which
     is an ordinary differential equation y′ = f(t, y) on a vector space; the method sees only
     ``f``, the state vector ``y`` and the error weights.
 
     The class is abstract: a subclass supplies the tableau as class attributes, and becomes
-    selectable by name in :func:`gmuk.integrate.simulate` (``method="name"``,
+    selectable by name in :func:`gmuk.engine.integrate.simulate` (``method="name"``,
     case-insensitive) as soon as it sets its own ``name``::
 
         class Ralston(RungeKuttaMethod):

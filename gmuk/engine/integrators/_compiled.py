@@ -1,5 +1,5 @@
-"""The compiled step loop: gmuk's one integrator loop, the RKMK method of :mod:`gmuk.integrate`
-run in machine code.
+"""The compiled step loop: gmuk's one integrator loop, the RKMK method of
+:mod:`gmuk.engine.integrate` run in machine code.
 
 Every System runs here. The parts that have compiled forms run compiled: the built-in
 gravity, uniform-gravity and linear spring–damper models (``ForceModel._compiled_term``,
@@ -22,9 +22,9 @@ step-size controller's constants and, for DOP853, its continuous extension and d
 control. A method that replaces the tableau's step with its own Python (``stages``,
 ``error_norm``, ``interpolant``) cannot run here; :func:`program` says so.
 
-The loop sees no System: it runs a :class:`~gmuk.integrators._program.Program`, the arrays and
-the Python callback that a System builds from its parts' declarations
-(:meth:`gmuk.System.compiled_program`, :mod:`gmuk.integrators._program`).
+The loop sees no System: it runs a :class:`~gmuk.engine.integrators._program.Program`, the arrays
+and the Python callback that a System builds from its parts' declarations
+(:meth:`gmuk.System.compiled_program`, :mod:`gmuk.engine.integrators._program`).
 
 The loop runs a chunk of steps and returns, so that Python can see stop requests, write
 checkpoints and drain the output buffers between chunks. It is compiled once per machine,
@@ -50,13 +50,11 @@ from numba import types
 from numba.extending import intrinsic
 
 from gmuk._numba import njit
-from gmuk._uk_kernels import _qr_solve, rigid_free_accel, uk_rigid
 from gmuk.constraints._kernels import apply_rows
 from gmuk.control._kernels import apply_control
-from gmuk.forces._kernels import apply_term
-from gmuk.gravity import _kernels as _field_kernels
-from gmuk.integrators import _dop853_tableau as _tab
-from gmuk.integrators._program import (
+from gmuk.engine._uk_kernels import _qr_solve, rigid_free_accel, uk_rigid
+from gmuk.engine.integrators import _dop853_tableau as _tab
+from gmuk.engine.integrators._program import (
     FUSED,
     PHASE_ACCELERATIONS,
     PHASE_CONTROLS,
@@ -66,6 +64,8 @@ from gmuk.integrators._program import (
     Program,
     reference_records,
 )
+from gmuk.forces._kernels import apply_term
+from gmuk.gravity import _kernels as _field_kernels
 from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
 
 __all__ = ["Status", "advance", "compile_loop", "loaded"]
@@ -430,7 +430,7 @@ def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[n
 
 @njit(cache=True)
 def _scale(Y0, Y1, G0, nr, pts, rtol, atol, sc):  # type: ignore[no-untyped-def]
-    """The error weights of :meth:`gmuk.integrate._Problem.scale` (``pts``: where the point
+    """The error weights of :meth:`gmuk.engine.integrate._Problem.scale` (``pts``: where the point
     masses' 3-vectors start in Y; other Euclidean entries are scalars)."""
     for i in range(Y0.shape[0]):
         sc[i] = atol + rtol * max(abs(Y0[i]), abs(Y1[i]))
@@ -463,7 +463,7 @@ def _rms(v, sc):  # type: ignore[no-untyped-def]
 
 @njit(cache=True)
 def _interpolate(F, Y0, s, out):  # type: ignore[no-untyped-def]
-    """DOP853's continuous extension u(s) into ``out`` (gmuk.integrators.dop853)."""
+    """DOP853's continuous extension u(s) into ``out`` (gmuk.engine.integrators.dop853)."""
     n = Y0.shape[0]
     p = F.shape[0]
     acc = np.zeros(n)
@@ -880,7 +880,7 @@ _ready = False  # the loop is compiled or loaded in this process (every program'
 
 def signature(prog: Program | None = None) -> tuple[Any, ...]:
     """The numba argument types of :func:`advance` as the driver calls it: every program has
-    the same types (:func:`gmuk.integrators._program.reference_records` stands for all)."""
+    the same types (:func:`gmuk.engine.integrators._program.reference_records` stands for all)."""
     from numba import typeof
 
     parts, method = (prog.parts, prog.method) if prog is not None else reference_records()

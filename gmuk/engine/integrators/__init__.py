@@ -1,4 +1,4 @@
-"""Runge–Kutta methods for :func:`gmuk.integrate.simulate`, as objects.
+"""Runge–Kutta methods for :func:`gmuk.engine.integrate.simulate`, as objects.
 
 Each method is a subclass of :class:`RungeKuttaMethod` that owns its Butcher tableau
 (A, b, c, order, embedded error weights E, FSAL flag) and its method-specific behaviour:
@@ -23,10 +23,10 @@ itself, and ``simulate(..., method="name")`` accepts it (names are case-insensit
 method shipped with gmuk goes in its own module of this package, imported below.
 """
 
-from gmuk.integrators._base import METHODS, RungeKuttaMethod, get_method, method_names
-from gmuk.integrators.dop853 import DOP853
-from gmuk.integrators.dopri5 import DOPRI5
-from gmuk.integrators.rk4 import RK4
+from gmuk.engine.integrators._base import METHODS, RungeKuttaMethod, get_method, method_names
+from gmuk.engine.integrators.dop853 import DOP853
+from gmuk.engine.integrators.dopri5 import DOPRI5
+from gmuk.engine.integrators.rk4 import RK4
 
 __all__ = [
     "DOP853",

@@ -1,6 +1,6 @@
 """DOP853: Dormand–Prince 8(5,3) with a continuous extension of order 7 and control of its
 error (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.10; coefficients in
-:mod:`gmuk.integrators._dop853_tableau`)."""
+:mod:`gmuk.engine.integrators._dop853_tableau`)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from typing import ClassVar
 import numpy as np
 
 from gmuk._validation import FloatArray
-from gmuk.integrators import _dop853_tableau as _tab
-from gmuk.integrators._base import RHS, RungeKuttaMethod
+from gmuk.engine.integrators import _dop853_tableau as _tab
+from gmuk.engine.integrators._base import RHS, RungeKuttaMethod
 
 __all__ = ["DOP853"]
 
