@@ -239,3 +239,152 @@ def check_sequence(value: Any, name: str) -> tuple[Any, ...]:
             f"{name} must be a sequence (list or tuple); got {type(value).__name__} {value!r:.60}"
         )
     return tuple(value)
+
+
+def strict_bool(value: Any, name: str, *, error: type[Exception] | None = None) -> bool:
+    """``value`` as a bool, accepting only ``True``, ``False`` and numpy booleans.
+
+    Truthiness is never used: the string ``"False"`` (true in Python), ``0``, ``1``, ``None``
+    and arrays are refused, so that an option spelled wrongly cannot silently switch a
+    feature on or off.
+
+    Parameters
+    ----------
+    value : object
+        The option's value.
+    name : str
+        Its name, for the message.
+    error : type of Exception, optional
+        What to raise (default :class:`gmuk.errors.DefinitionError`).
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    DefinitionError
+        (or ``error``) naming ``name``, saying that a bool was expected and what came in.
+    """
+    from gmuk.errors import DefinitionError
+
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    exc = error or DefinitionError
+    raise exc(f"{name} must be True or False (a bool); got {type(value).__name__} {value!r:.60}")
+
+
+def real_vector(
+    value: Any,
+    name: str,
+    size: int,
+    *,
+    scalar: bool = False,
+    positive: bool = False,
+    non_negative: bool = False,
+    error: type[Exception] | None = None,
+) -> FloatArray:
+    """``value`` as a finite float64 vector of ``size`` real numbers (a new array).
+
+    Booleans, complex numbers, strings, None and objects are refused (not converted), as are
+    NaN, ±inf, the wrong shape and, as asked, values ≤ 0 or < 0.
+
+    Parameters
+    ----------
+    value : array_like
+        The input: ``size`` numbers, or one number when ``scalar`` is True (then repeated).
+    name : str
+        Its name, for the message.
+    size : int
+        The required length.
+    scalar : bool
+        Whether a single number is accepted and broadcast to ``size`` entries.
+    positive, non_negative : bool
+        Require every entry > 0, or ≥ 0.
+    error : type of Exception, optional
+        What to raise (default :class:`gmuk.errors.DefinitionError`).
+
+    Returns
+    -------
+    ndarray, shape (size,)
+
+    Raises
+    ------
+    DefinitionError
+        (or ``error``) naming ``name``, what was expected and what came in.
+    """
+    from gmuk.errors import DefinitionError, GmukError
+
+    exc = error or DefinitionError
+    sign = " > 0" if positive else " ≥ 0" if non_negative else ""
+    what = f"a finite number{sign} or {size} such numbers" if scalar else f"{size} finite numbers"
+    if not scalar:
+        what += sign
+    try:
+        if _holds_not_real(value):  # numpy would read (1.0, True) as (1.0, 1.0)
+            raise GmukError
+        v = np.array(_real_float64(value, (size,), name, batch=False), dtype=np.float64)
+    except GmukError:
+        raise exc(f"{name} must be {what}; got {type(value).__name__} {value!r:.60}") from None
+    if scalar and v.ndim == 0:
+        v = np.full(size, float(v))
+    if v.shape != (size,):
+        raise exc(f"{name} must be {what}; got shape {v.shape}: {value!r:.60}")
+    if not all_finite(v):
+        raise exc(f"{name} must be finite; got {v.tolist()}")
+    if (positive and not (v > 0.0).all()) or (non_negative and not (v >= 0.0).all()):
+        raise exc(f"{name} must be {what}; got {v.tolist()}")
+    return v
+
+
+def distinct_bodies(bodies: Any, who: str) -> tuple[Any, ...]:
+    """``bodies`` (Body objects or names) as a tuple, refusing one listed twice.
+
+    A body is identified by its name: the same Body object twice, or a Body and its name,
+    are the same body. Entries that are neither (checked later by the System) are compared
+    by identity.
+
+    Parameters
+    ----------
+    bodies : sequence of Body or str
+        The bodies a part acts on.
+    who : str
+        The part, for the message (e.g. ``"SpringDamper 'tether'"``).
+
+    Returns
+    -------
+    tuple
+
+    Raises
+    ------
+    DefinitionError
+        Naming every body listed more than once and its positions.
+    """
+    from gmuk.errors import DefinitionError
+
+    items = tuple(bodies)
+    seen: dict[Any, list[int]] = {}
+    for i, b in enumerate(items):
+        name = b if isinstance(b, str) else getattr(b, "name", None)
+        key = ("name", name) if isinstance(name, str) else ("id", id(b))
+        seen.setdefault(key, []).append(i)
+    repeated = [(key, where) for key, where in seen.items() if len(where) > 1]
+    if repeated:
+        listing = "; ".join(
+            f"{items[where[0]] if key[0] == 'id' else key[1]!r} at positions {where}"
+            for key, where in repeated
+        )
+        raise DefinitionError(
+            f"{who} lists the same body more than once ({listing}); each body may appear "
+            "once (a part acting on a body with itself has no meaning: two entries would be "
+            "two columns, or two loads, for one body)"
+        )
+    return items
+
+
+def _holds_not_real(value: Any) -> bool:
+    """Whether a list or tuple (nested) holds a bool, complex number or string, which numpy
+    would convert along with its real neighbours."""
+    if isinstance(value, (list, tuple)):
+        return any(isinstance(v, NOT_REAL) or _holds_not_real(v) for v in value)
+    return False
