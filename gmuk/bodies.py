@@ -16,9 +16,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from gmuk._validation import NOT_REAL, FloatArray
-from gmuk.dynamics import check_inertia
-from gmuk.errors import DefinitionError, InertiaError
+from gmuk._validation import FloatArray
+from gmuk.dynamics import check_inertia, check_mass
+from gmuk.errors import DefinitionError
 
 __all__ = ["Body", "BodyKind", "PointMass", "RigidBody", "SlackCoordinate"]
 
@@ -30,15 +30,8 @@ def _check_name(name: Any) -> str:
 
 
 def _check_mass(mass: Any, name: str) -> float:
-    try:
-        if isinstance(mass, NOT_REAL):  # float() would take True and "2" silently
-            raise TypeError
-        m = float(mass)
-    except (TypeError, ValueError, OverflowError):
-        raise InertiaError(f"{name}: mass must be a positive number (kg); got {mass!r}") from None
-    if not np.isfinite(m) or m <= 0.0:
-        raise InertiaError(f"{name}: mass must be finite and > 0 (kg); got {m!r}")
-    return m
+    """The mass (kg) as :func:`gmuk.dynamics.check_mass` accepts it (1/m finite too)."""
+    return check_mass(mass, name)
 
 
 class BodyKind(str, enum.Enum):
@@ -75,7 +68,16 @@ class Body(abc.ABC):
     name : str
         Unique name within a System.
     mass : float
-        Mass (kg), finite and > 0.
+        Mass (kg): a real number (not a bool or a string) with m and 1/m finite normal
+        float64 numbers, 2.2e-308 ≤ m ≤ 4.5e307 (:func:`gmuk.dynamics.check_mass`; a
+        subnormal mass such as 5e-324 is refused, its reciprocal being infinite).
+
+    Raises
+    ------
+    DefinitionError
+        If ``name`` is not a non-empty string.
+    InertiaError
+        If ``mass`` is not usable.
     """
 
     dof: ClassVar[int]
@@ -119,10 +121,18 @@ class RigidBody(Body):
     name : str
         Unique name.
     mass : float
-        Mass m (kg), > 0.
+        Mass m (kg), 2.2e-308 ≤ m ≤ 4.5e307 (m and 1/m finite normal numbers).
     inertia : array_like, shape (3, 3)
-        Central inertia tensor J in the body frame (kg·m²): symmetric positive definite,
-        principal moments satisfying the triangle inequality.
+        Central inertia tensor J in the body frame (kg·m²): finite, symmetric positive
+        definite, principal moments satisfying the triangle inequality, each between
+        2.2e-308 and 4.5e307 kg·m² (J⁻¹ finite), and J₃/J₁ ≤ 1e12 (J⁻¹ usable). See
+        :func:`gmuk.dynamics.check_inertia`.
+
+    Raises
+    ------
+    InertiaError
+        Listing every problem with the mass and J (e.g. mass 5e-324 or J = 1e-320 I, whose
+        inverses are infinite; entries near 1e308).
 
     Notes
     -----

@@ -12,12 +12,14 @@ from typing import Any
 import numpy as np
 
 from gmuk._numba import njit
-from gmuk._validation import NOT_REAL, FloatArray, as_array, check_se3
+from gmuk._validation import NOT_REAL, FloatArray, as_array, check_se3, finite_result
 from gmuk.errors import InertiaError
 from gmuk.lie import se3
 
 __all__ = [
     "check_inertia",
+    "check_mass",
+    "check_spatial_inertia",
     "free_acceleration",
     "g_ddot",
     "kinetic_energy",
@@ -28,6 +30,72 @@ __all__ = [
 
 #: Relative tolerance for symmetry of J and for the triangle inequalities of its moments.
 INERTIA_TOL = 1e-9
+
+#: Smallest usable mass (kg) or principal moment (kg·m²): the smallest normal float64,
+#: 2.2e-308. Below it (5e-324, 1e-320) the number is subnormal and its reciprocal is inf.
+USABLE_MIN = float(np.finfo(np.float64).tiny)
+#: Largest usable mass or principal moment, 1/USABLE_MIN ≈ 4.5e307: its reciprocal is then
+#: still a normal number, and sums of three moments (the triangle inequality, tr J) are finite.
+USABLE_MAX = 1.0 / USABLE_MIN
+#: Largest condition number accepted for J (J₃/J₁) and for the 6×6 mass–inertia tensor
+#: scaled to a unit diagonal: the inverse then keeps about 4 significant digits
+#: (relative error ≈ cond · ε ≈ 2e-4).
+MAX_CONDITION = 1e12
+
+
+def check_mass(mass: Any, name: str = "body") -> float:
+    """Validate a mass (kg): a real number m with m and 1/m finite normal float64 numbers.
+
+    Parameters
+    ----------
+    mass : float
+        Mass m (kg); :data:`USABLE_MIN` (2.2e-308) ≤ m ≤ :data:`USABLE_MAX` (4.5e307).
+        Booleans, strings and complex numbers are refused, not converted.
+    name : str
+        Used in error messages.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    InertiaError
+        If ``mass`` is not a real number, not finite, ≤ 0, or outside the usable range
+        (a subnormal mass such as 5e-324 has 1/m = inf).
+    """
+    m = _real_mass(mass, name)
+    problem = _mass_problem(m)
+    if problem:
+        raise InertiaError(f"{name}: {problem}")
+    return m
+
+
+def _real_mass(mass: Any, name: str) -> float:
+    """``mass`` as a float, refusing what is not a real number (bool, str, complex, arrays)."""
+    try:
+        if isinstance(mass, NOT_REAL) or np.ndim(mass) != 0:  # float() would take True, "2"
+            raise TypeError
+        return float(mass)
+    except (TypeError, ValueError, OverflowError):
+        msg = f"{name}: mass must be a positive number (kg); got {mass!r:.60}"
+        raise InertiaError(msg) from None
+
+
+def _mass_problem(m: float) -> str:
+    if not np.isfinite(m) or m <= 0.0:
+        return f"mass must be finite and > 0 (kg); got {m!r}"
+    if not USABLE_MIN <= m <= USABLE_MAX:
+        return (
+            f"mass must be between {USABLE_MIN:.3g} and {USABLE_MAX:.3g} kg so that m and 1/m "
+            f"are finite normal numbers; got {m!r} (1/m = {_reciprocal(m)!r})"
+        )
+    return ""
+
+
+def _reciprocal(x: float) -> float:
+    with np.errstate(all="ignore"):
+        return float(np.float64(1.0) / np.float64(x))
 
 
 @njit(cache=True)
@@ -64,10 +132,14 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
     Parameters
     ----------
     mass : float
-        Mass m (kg), finite and > 0.
+        Mass m (kg), as :func:`check_mass`: finite, > 0, with m and 1/m normal float64
+        numbers (2.2e-308 ≤ m ≤ 4.5e307).
     J : array_like, shape (3, 3)
-        Inertia tensor about the centre of mass in the body frame (kg·m²): symmetric,
-        positive definite, principal moments satisfying ``Jᵢ + Jⱼ ≥ Jₖ`` (to 1e-9 relative).
+        Inertia tensor about the centre of mass in the body frame (kg·m²): finite, symmetric
+        (to 1e-9 relative), positive definite, principal moments J₁ ≤ J₂ ≤ J₃ satisfying the
+        triangle inequality ``J₁ + J₂ ≥ J₃`` (to 1e-9 relative), each moment between
+        2.2e-308 and 4.5e307 kg·m² (so that J⁻¹ is finite), and ``J₃/J₁ ≤ 1e12``
+        (:data:`MAX_CONDITION`: J⁻¹ then keeps about 4 significant digits).
     name : str
         Used in error messages.
 
@@ -80,16 +152,19 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
     ------
     InertiaError
         Listing every violated condition with the values that came in.
+    ShapeError, NonFiniteError
+        If J is not (3, 3), or holds NaN or inf.
+
+    Notes
+    -----
+    The usable range and the condition bound are gmuk's, not the thesis's: a subnormal mass
+    (5e-324) or moment (1e-320) is positive but its reciprocal is infinite, and the
+    integrator divides by both.
     """
     problems: list[str] = []
-    try:
-        if isinstance(mass, NOT_REAL):  # float() would take True and "2" silently
-            raise TypeError
-        m = float(mass)
-    except (TypeError, ValueError, OverflowError):
-        raise InertiaError(f"{name}: mass must be a positive number (kg); got {mass!r}") from None
-    if not np.isfinite(m) or m <= 0.0:
-        problems.append(f"mass must be finite and > 0 (kg); got {m!r}")
+    m = _real_mass(mass, name)
+    if problem := _mass_problem(m):
+        problems.append(problem)
     Jm = as_array(J, (3, 3), f"{name}: inertia", batch=False)
     scale = max(float(np.abs(Jm).max()), np.finfo(float).tiny)
     asym = float(np.abs(Jm / scale - Jm.T / scale).max()) * scale  # no overflow near 1e308
@@ -97,21 +172,110 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
         problems.append(f"inertia must be symmetric; got max|J − Jᵀ| = {asym:.3g} kg·m²")
     else:
         # eigenvalues of J / scale, then scaled back: no overflow for entries near 1e308
-        moments = np.linalg.eigvalsh(0.5 * (Jm / scale + Jm.T / scale)) * scale
+        scaled = np.linalg.eigvalsh(0.5 * (Jm / scale + Jm.T / scale))
+        with np.errstate(over="ignore"):  # a moment beyond 1.8e308 is shown as inf
+            moments = scaled * scale
+        shown = np.array2string(moments, precision=6)
         if moments[0] <= 0.0:
             problems.append(
-                f"inertia must be positive definite; got principal moments "
-                f"{np.array2string(moments, precision=6)} kg·m²"
+                f"inertia must be positive definite; got principal moments {shown} kg·m²"
             )
-        elif moments[0] / scale + moments[1] / scale < moments[2] / scale * (1.0 - INERTIA_TOL):
+        elif scaled[0] + scaled[1] < scaled[2] * (1.0 - INERTIA_TOL):
             problems.append(
                 f"principal moments must satisfy the triangle inequality J₁ + J₂ ≥ J₃; got "
-                f"{np.array2string(moments, precision=6)} kg·m² "
-                f"({moments[0] + moments[1]:.6g} < {moments[2]:.6g})"
+                f"{shown} kg·m² ({moments[0] + moments[1]:.6g} < {moments[2]:.6g})"
+            )
+        elif not (USABLE_MIN <= moments[0] and moments[2] <= USABLE_MAX):
+            problems.append(
+                f"principal moments must be between {USABLE_MIN:.3g} and {USABLE_MAX:.3g} "
+                f"kg·m² so that J⁻¹ is finite; got {shown} kg·m² "
+                f"(1/J₁ = {_reciprocal(moments[0])!r})"
+            )
+        elif scaled[2] > MAX_CONDITION * scaled[0]:
+            problems.append(
+                f"inertia is too ill-conditioned to invert: J₃/J₁ must be ≤ {MAX_CONDITION:g}; "
+                f"got principal moments {shown} kg·m² (J₃/J₁ = {scaled[2] / scaled[0]:.3g})"
             )
     if problems:
         raise InertiaError(f"{name}: " + "; ".join(problems))
     return m, Jm
+
+
+def check_spatial_inertia(inertia: Any, name: str = "inertia") -> FloatArray:
+    """Validate 6×6 mass–inertia tensors 𝕀 (kg·m², kg·m, kg; body frame).
+
+    Each 𝕀 must be finite, symmetric (to 1e-9 relative to its largest entry), positive
+    definite, have each diagonal entry between 2.2e-308 and 4.5e307 (a normal float64 with a
+    normal reciprocal), be well-conditioned (the condition number of ``D^-½ 𝕀 D^-½``, D its
+    diagonal, at most :data:`MAX_CONDITION` = 1e12: a unit-free measure, 𝕀 mixing kg·m² and
+    kg), and have a finite inverse. :func:`spatial_inertia` of a mass and J accepted by
+    :func:`check_inertia` passes (J₃/J₁ ≤ 1e12 bounds the scaled condition).
+
+    Parameters
+    ----------
+    inertia : array_like, shape (6, 6) or (..., 6, 6)
+        Mass–inertia tensors acting on twists [ω; v].
+    name : str
+        Used in error messages.
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6)
+        ``inertia`` as float64.
+
+    Raises
+    ------
+    InertiaError
+        Naming the first failing tensor (its batch index) and what is wrong with it.
+    ShapeError, NonFiniteError
+        If the trailing shape is not (6, 6), or an entry is NaN or inf.
+    """
+    I = as_array(inertia, (6, 6), name)
+    flat = I.reshape(-1, 6, 6)
+    if flat.shape[0] == 0:
+        return I
+    scale = np.maximum(np.abs(flat).max(axis=(1, 2)), USABLE_MIN)[:, None, None]
+    S = flat / scale  # entries in [-1, 1]: nothing below overflows
+    asym = np.abs(S - np.swapaxes(S, 1, 2)).max(axis=(1, 2))
+    diag = np.diagonal(flat, axis1=1, axis2=2)
+    d = np.diagonal(S, axis1=1, axis2=2)
+    with np.errstate(all="ignore"):
+        root = np.sqrt(np.where(d > 0.0, d, np.nan))
+        C = 0.5 * (S + np.swapaxes(S, 1, 2)) / (root[:, :, None] * root[:, None, :])
+        C = np.where(np.isfinite(C), C, 0.0)
+        lam = np.linalg.eigvalsh(C)
+        usable = (lam[:, 0] > 0.0) & (d > 0.0).all(axis=1)
+        C_inv = np.linalg.inv(np.where(usable[:, None, None], C, np.eye(6)))
+        inv = C_inv / (root[:, :, None] * root[:, None, :]) / scale
+    for k in range(flat.shape[0]):
+        where = (
+            f" at index {tuple(int(j) for j in np.unravel_index(k, I.shape[:-2]))}"
+            if I.ndim > 2
+            else ""
+        )
+        problem = ""
+        if asym[k] > INERTIA_TOL:
+            problem = f"must be symmetric; got max|𝕀 − 𝕀ᵀ| = {asym[k] * scale[k, 0, 0]:.3g}"
+        elif not (d[k] > 0.0).all() or not lam[k, 0] > 0.0:
+            problem = (
+                "must be positive definite (a negative or zero direction gives a negative "
+                f"or zero kinetic energy); got diagonal {diag[k].tolist()}"
+            )
+        elif not ((diag[k] >= USABLE_MIN) & (diag[k] <= USABLE_MAX)).all():
+            problem = (
+                f"must have diagonal entries between {USABLE_MIN:.3g} and {USABLE_MAX:.3g} "
+                f"(a finite inverse); got {diag[k].tolist()}"
+            )
+        elif lam[k, -1] > MAX_CONDITION * lam[k, 0]:
+            problem = (
+                f"is too ill-conditioned to invert: the condition number of 𝕀 scaled to a unit "
+                f"diagonal must be ≤ {MAX_CONDITION:g}; got {lam[k, -1] / lam[k, 0]:.3g}"
+            )
+        elif not np.isfinite(inv[k]).all():
+            problem = "must have a finite inverse; its inverse overflows float64"
+        if problem:
+            raise InertiaError(f"{name}{where} {problem}")
+    return I
 
 
 def spatial_inertia(mass: Any, J: Any) -> FloatArray:
@@ -168,11 +332,15 @@ def free_acceleration(V: Any, inertia: Any, wrench: Any = None) -> FloatArray:
     Raises
     ------
     InertiaError
-        If 𝕀 is not of the form blkdiag(J, m I₃) (its off-diagonal blocks zero and its
-        lower block m times the identity, exactly as :func:`spatial_inertia` builds it).
+        If 𝕀 fails :func:`check_spatial_inertia` (not symmetric positive definite, or no
+        usable inverse), or is not of the form blkdiag(J, m I₃) (its off-diagonal blocks
+        zero and its lower block m times the identity, exactly as :func:`spatial_inertia`
+        builds it).
+    NonFiniteError
+        If the result overflows float64.
     """
     V = as_array(V, (6,), "V")
-    I = as_array(inertia, (6, 6), "inertia")
+    I = check_spatial_inertia(inertia)
     tau = np.zeros(6) if wrench is None else as_array(wrench, (6,), "wrench")
     m = I[..., 3, 3]
     lower = I[..., 3:, 3:]
@@ -198,7 +366,7 @@ def free_acceleration(V: Any, inertia: Any, wrench: Any = None) -> FloatArray:
         np.array(np.broadcast_to(m, shape), dtype=np.float64).reshape(n),
         np.array(np.broadcast_to(tau, (*shape, 6)), dtype=np.float64).reshape(n, 6),
     )
-    return out.reshape(*shape, 6)
+    return finite_result(out.reshape(*shape, 6), "free_acceleration", "V", V)
 
 
 def g_ddot(g: Any, V: Any, V_dot: Any) -> FloatArray:
@@ -238,10 +406,21 @@ def kinetic_energy(V: Any, inertia: Any) -> FloatArray:
     Returns
     -------
     ndarray, shape (...)
+        ≥ 0.
+
+    Raises
+    ------
+    InertiaError
+        If 𝕀 fails :func:`check_spatial_inertia` (e.g. not positive definite: a negative
+        kinetic energy would follow).
+    NonFiniteError
+        If the energy overflows float64.
     """
     V = as_array(V, (6,), "V")
-    I = as_array(inertia, (6, 6), "inertia")
-    return 0.5 * np.einsum("...i,...i->...", V, (I @ V[..., None])[..., 0])
+    I = check_spatial_inertia(inertia)
+    with np.errstate(over="ignore", invalid="ignore"):
+        T = 0.5 * np.einsum("...i,...i->...", V, (I @ V[..., None])[..., 0])
+    return finite_result(T, "kinetic_energy", "V", V)
 
 
 def spatial_momentum(g: Any, V: Any, inertia: Any) -> FloatArray:
@@ -256,14 +435,20 @@ def spatial_momentum(g: Any, V: Any, inertia: Any) -> FloatArray:
     V : array_like, shape (..., 6)
         Body twist.
     inertia : array_like, shape (6, 6) or (..., 6, 6)
+        Mass–inertia tensor 𝕀, body frame (:func:`spatial_inertia`).
 
     Returns
     -------
     ndarray, shape (..., 6)
         [angular momentum about the origin of N; linear momentum], in N (kg·m²/s, kg·m/s).
+
+    Raises
+    ------
+    InertiaError
+        If 𝕀 fails :func:`check_spatial_inertia`.
     """
     g = check_se3(g, "g")
     V = as_array(V, (6,), "V")
-    I = as_array(inertia, (6, 6), "inertia")
+    I = check_spatial_inertia(inertia)
     AdT = np.swapaxes(se3._Ad(se3._inverse(g)), -1, -2)
     return (AdT @ (I @ V[..., None]))[..., 0]

@@ -110,8 +110,11 @@ def test_a_list_pair_of_rows_is_accepted(state):
 
 
 def test_extreme_inertia_is_checked_without_overflow():
-    body = gmuk.RigidBody("big", 1.0, np.eye(3) * 1e308)  # valid, if absurd
-    assert body.inertia[0, 0] == 1e308
+    # 1e308 kg·m² has a subnormal inverse (1e-308 < 2.2e-308): refused since issue #25
+    with pytest.raises(gmuk.errors.InertiaError, match="J⁻¹ is finite"):
+        gmuk.RigidBody("big", 1.0, np.eye(3) * 1e308)
+    body = gmuk.RigidBody("big", 1.0, np.eye(3) * 4e307)  # valid, if absurd
+    assert body.inertia[0, 0] == 4e307
     with pytest.raises(gmuk.errors.InertiaError, match="triangle inequality"):
         gmuk.RigidBody("flat", 1.0, np.diag([1e307, 1e307, 1e308]))
 

@@ -263,14 +263,46 @@ def scaled_inertia(J: Any, factors: Any, mass_scale: float = 1.0) -> np.ndarray:
     ``Aᵢ = (tr J)/2 − Jᵢ`` in principal axes, ``Aᵢ ← sᵢ Aᵢ``, ``Jᵢ = Σ A − Aᵢ``, same axes: the
     result satisfies the triangle inequality whenever J does
     (:class:`~gmuk.campaign.dispersions.SecondMomentScale`).
+
+    Parameters
+    ----------
+    J : array_like, shape (3, 3)
+        A physical central inertia (kg·m²), as :func:`gmuk.dynamics.check_inertia` accepts
+        it: symmetric positive definite, triangle inequality, usable inverse.
+    factors : array_like, shape (3,)
+        Finite real scale factors > 0 of the second moments A₁, A₂, A₃.
+    mass_scale : float
+        Finite real factor > 0 on the whole tensor.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        The dispersed inertia (kg·m²), itself checked by :func:`~gmuk.dynamics.check_inertia`.
+
+    Raises
+    ------
+    InertiaError
+        If J is zero, not symmetric positive definite, violates the triangle inequality or
+        has no usable inverse, or if the scaled result has no usable inverse.
+    DefinitionError
+        If ``factors`` is not 3 finite numbers > 0 or ``mass_scale`` not a finite number
+        > 0 (booleans and strings are refused).
     """
-    J = np.asarray(J, dtype=float)
-    moments, axes = np.linalg.eigh(J)
-    A = 0.5 * moments.sum() - moments
-    A = np.asarray(factors, dtype=float) * A
+    from gmuk._validation import real_number, real_vector
+    from gmuk.dynamics import check_inertia
+
+    _, J = check_inertia(1.0, J, name="scaled_inertia: J")
+    s = real_vector(factors, "scaled_inertia: factors", 3, positive=True)
+    k = real_number(mass_scale, "scaled_inertia: mass_scale", positive=True)
+    moments, axes = np.linalg.eigh(0.5 * (J + J.T))
+    A = np.maximum(0.5 * moments.sum() - moments, 0.0)  # ≥ 0 by the triangle inequality
+    A = s * A
     dispersed = A.sum() - A
-    out = mass_scale * (axes * dispersed) @ axes.T
-    return np.asarray(0.5 * (out + out.T))
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = k * (axes * dispersed) @ axes.T
+        out = np.asarray(0.5 * (out + out.T))
+    _, out = check_inertia(1.0, out, name="scaled_inertia: the scaled inertia")
+    return out
 
 
 def _attitude_pose(g_ref: np.ndarray, rotation: Any, dr_N: Any) -> np.ndarray:
