@@ -86,7 +86,7 @@ import numpy as np
 
 from gmuk._forms import Forms
 from gmuk._numba import njit
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, real_number, real_vector, strict_bool
 from gmuk.bodies import BodyKind, RigidBody
 from gmuk.control.base import Controller
 from gmuk.errors import DefinitionError
@@ -339,32 +339,15 @@ class TrackingErrors:
 
 
 def _gain_vector(value: Any, name: str, *, positive: bool = True) -> FloatArray:
-    """A scalar or (3,) gain as a finite (3,) vector, > 0 (or ≥ 0)."""
-    try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise DefinitionError(f"{name} must be a number or 3 numbers; got {value!r}") from None
-    if v.ndim == 0:
-        v = np.full(3, float(v))
-    if v.shape != (3,) or not np.isfinite(v).all():
-        raise DefinitionError(
-            f"{name} must be a finite scalar or a (3,) array; got shape {v.shape}: {value!r}"
-        )
-    if positive and not (v > 0).all():
-        raise DefinitionError(f"{name} must be > 0; got {v.tolist()}")
-    if not positive and not (v >= 0).all():
-        raise DefinitionError(f"{name} must be ≥ 0; got {v.tolist()}")
-    return v
+    """A scalar or (3,) gain as a finite (3,) vector, > 0 (or ≥ 0); booleans, strings and
+    complex numbers are refused (:func:`gmuk._validation.real_vector`)."""
+    return real_vector(value, name, 3, scalar=True, positive=positive, non_negative=not positive)
 
 
 def _gain_scalar(value: Any, name: str, *, positive: bool = True) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise DefinitionError(f"{name} must be a number; got {value!r}") from None
-    if not np.isfinite(v) or (v <= 0 if positive else v < 0):
-        raise DefinitionError(f"{name} must be finite and {'>' if positive else '≥'} 0; got {v!r}")
-    return v
+    """A finite real gain, > 0 (or ≥ 0); booleans, strings and complex numbers are refused
+    (:func:`gmuk._validation.real_number`)."""
+    return real_number(value, name, positive=positive, non_negative=not positive)
 
 
 class MorseLyapunovController(Controller):
@@ -396,7 +379,8 @@ class MorseLyapunovController(Controller):
         c, the weight of the Morse function in W (analysis only, not in u). Must satisfy
         c < 4 k₁₁ min(k₂₁) for Ẇ ≤ 0. Default 0.2.
     robust : bool
-        Add Eq. 90's term ``−𝕀 κ₂ O/‖r‖⁴`` (O a 6-vector of ones). As printed, with
+        Add Eq. 90's term ``−𝕀 κ₂ O/‖r‖⁴`` (O a 6-vector of ones); exactly True or False
+        (a string such as ``"False"`` is refused, not read by its truthiness). As printed, with
         κ₂ = −39/2, it is of order 1e-25 m/s² on a lunar orbit (the units of κ₂ are not
         stated; the term is kept as printed for reproduction); pass ``bound`` for a bound of
         your own.
@@ -410,6 +394,14 @@ class MorseLyapunovController(Controller):
         ``−(ad*_V 𝕀V − ad*_{V_n} 𝕀V_n)`` and integral gain k₃ = ``k_integral``, default then
         1000); it diverges on the LVLH orbit and is kept to show it.
     name : str, optional
+
+    Raises
+    ------
+    DefinitionError
+        If a gain is not a finite real number (or, for k21, k22, a, 3 of them) of the
+        stated sign: booleans, strings and complex numbers are refused, not converted; if
+        ``robust`` is not a bool, ``variant`` not one of the two names, ``bound`` not
+        callable, or ``a`` not 3 distinct numbers.
 
     Notes
     -----
@@ -452,13 +444,12 @@ class MorseLyapunovController(Controller):
                 "reference must be a gmuk.ReferenceTrajectory (e.g. gmuk.orbits.LVLHReference); "
                 f"got {type(reference).__name__}: {reference!r}"
             )
-        if variant not in ("corrected", "thesis"):
+        if not isinstance(variant, str) or variant not in ("corrected", "thesis"):
             raise DefinitionError(f"variant must be 'corrected' or 'thesis'; got {variant!r}")
         if bound is not None and not callable(bound):
             raise DefinitionError(f"bound must be a callable (t, g, V) -> (6,); got {bound!r}")
-        aa = np.asarray(a, dtype=float) if np.ndim(a) == 1 else np.full(1, np.nan)
-        if aa.shape != (3,) or not np.isfinite(aa).all() or not (aa > 0).all():
-            raise DefinitionError(f"a must be 3 finite numbers > 0; got {a!r}")
+        robust = strict_bool(robust, "robust")
+        aa = real_vector(a, "a", 3, positive=True)
         if len(set(aa.tolist())) != 3:
             raise DefinitionError(
                 f"a must be 3 distinct numbers (else s(E_R) vanishes on whole circles of "
@@ -483,13 +474,8 @@ class MorseLyapunovController(Controller):
                 f"morse_weight must be < 4 k11 min(k21) = {limit:.6g} for the Lyapunov rate "
                 f"to be ≤ 0; got {self.morse_weight!r}"
             )
-        self.robust = bool(robust) or bound is not None
-        try:
-            self.kappa2 = float(kappa2)
-        except (TypeError, ValueError):
-            raise DefinitionError(f"kappa2 must be a number; got {kappa2!r}") from None
-        if not np.isfinite(self.kappa2):
-            raise DefinitionError(f"kappa2 must be finite; got {kappa2!r}")
+        self.robust = robust or bound is not None
+        self.kappa2 = real_number(kappa2, "kappa2")
         self.bound = bound
         self._K1 = np.concatenate([np.full(3, self.k11), np.full(3, self.k12)])
         self._K2 = np.concatenate([self.k21, self.k22])

@@ -30,7 +30,7 @@ import numpy as np
 from gmuk._casadi import casadi
 from gmuk._forms import Forms
 from gmuk._numba import njit
-from gmuk._validation import FloatArray, real_number
+from gmuk._validation import FloatArray, real_number, strict_bool
 from gmuk.bodies import BodyKind
 from gmuk.celestial import CelestialBody, UniformRotation
 from gmuk.errors import DefinitionError, GmukError
@@ -286,9 +286,20 @@ class SphericalHarmonicGravity(ForceModel):
     degree : int, optional
         Truncate the field to this degree (default: the field's own).
     finite_size_force : bool
-        Include the ½ ∇³U : Π force term (default True).
+        Include the ½ ∇³U : Π force term (default True); exactly True or False (a string
+        such as ``"False"`` is refused, not read by its truthiness).
     bodies : sequence, optional
+        Each body at most once.
     modeled : bool
+        Exactly True or False.
+
+    Raises
+    ------
+    DefinitionError
+        If ``central_body`` has no field, ``finite_size_force`` or ``modeled`` is not a
+        bool, or ``bodies`` lists a body twice.
+    DegreeError
+        If ``degree`` is not an integer within the field's degree.
 
     Examples
     --------
@@ -336,7 +347,7 @@ class SphericalHarmonicGravity(ForceModel):
             )
         self.central_body = central_body
         self.field = field if degree is None else field.truncate(degree)
-        self.include_finite_size_force = bool(finite_size_force)
+        self.include_finite_size_force = strict_bool(finite_size_force, "finite_size_force")
         self._step = 2e-4 / (int(getattr(self.field, "degree", 0)) + 3)
 
     def wrench(self, t: float, g_NB: FloatArray, V_B: FloatArray, body: RigidBody) -> FloatArray:

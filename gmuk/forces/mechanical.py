@@ -50,8 +50,14 @@ class AppliedWrench(ForceModel):
         Frame of the given components. Inertial components of a rigid body's wrench are
         rotated into the body frame (torque about the centre of mass).
     modeled : bool
-        Whether the constraint solve knows it (default True).
+        Whether the constraint solve knows it (default True); exactly True or False.
     name : str, optional
+
+    Raises
+    ------
+    DefinitionError
+        If ``wrench`` is not a finite (6,) or (3,) array of real numbers or a callable,
+        ``frame`` is not one of the two names, or ``modeled`` is not a bool.
     """
 
     _forms = Forms(
@@ -69,7 +75,7 @@ class AppliedWrench(ForceModel):
         name: str | None = None,
     ) -> None:
         super().__init__([body], modeled=modeled, name=name)
-        if frame not in ("body", "inertial"):
+        if not isinstance(frame, str) or frame not in ("body", "inertial"):
             raise DefinitionError(f"frame must be 'body' or 'inertial'; got {frame!r}")
         if callable(wrench):
             self._fun: Callable[[float], Any] = wrench
