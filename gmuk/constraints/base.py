@@ -18,7 +18,7 @@ import scipy.sparse as sp
 
 from gmuk._forms import DeclaresForms
 from gmuk._frozen import FreezesInSystem
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, distinct_bodies
 from gmuk.bodies import BodyKind
 from gmuk.errors import ConstraintError, DefinitionError
 
@@ -80,9 +80,15 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
     Parameters
     ----------
     bodies : sequence of Body or str
-        The bodies whose velocities make the columns of A, in this order.
+        The bodies whose velocities make the columns of A, in this order; each at most
+        once (a Body and its name count as the same body).
     name : str, optional
         Label used in error messages and diagnostics.
+
+    Raises
+    ------
+    DefinitionError
+        If ``bodies`` is empty or lists a body more than once.
 
     Examples
     --------
@@ -106,7 +112,9 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
             bodies = [bodies]
         if len(bodies) == 0:
             raise DefinitionError(f"{type(self).__name__} needs at least one body")
-        object.__setattr__(self, "_bodies", tuple(bodies))
+        who = type(self).__name__ + (f" {name!r}" if name else "")
+        bodies = distinct_bodies(bodies, who)
+        object.__setattr__(self, "_bodies", bodies)
         object.__setattr__(self, "_name", name or type(self).__name__)
 
     def _compiled_term(self) -> tuple[int, tuple[float, ...], int] | None:

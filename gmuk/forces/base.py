@@ -30,7 +30,7 @@ import numpy as np
 from gmuk._forms import DeclaresForms
 from gmuk._frozen import FreezesInSystem
 from gmuk._numba import njit
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, check_sequence, distinct_bodies, strict_bool
 from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError, DomainError
 
@@ -73,11 +73,17 @@ class ForceModel(FreezesInSystem, DeclaresForms):
     Parameters
     ----------
     bodies : sequence of Body or str, optional
-        The bodies it acts on; default: every body of the System whose kind is in
-        :attr:`acts_on`.
+        The bodies it acts on, each at most once (a Body and its name count as the same
+        body); default: every body of the System whose kind is in :attr:`acts_on`.
     modeled : bool
-        Whether the constraint solve knows this force (default True).
+        Whether the constraint solve knows this force (default True); exactly True or
+        False (``"False"``, 0 or None are refused, not read by their truthiness).
     name : str, optional
+
+    Raises
+    ------
+    DefinitionError
+        If ``bodies`` is not a sequence or lists a body twice, or ``modeled`` is not a bool.
 
     Attributes
     ----------
@@ -120,8 +126,11 @@ class ForceModel(FreezesInSystem, DeclaresForms):
                 f"{type(self).__name__} implements neither wrench() (rigid bodies) nor "
                 "force() (point masses), nor wrenches(); a ForceModel needs at least one"
             )
-        object.__setattr__(self, "_bodies", None if bodies is None else tuple(bodies))
-        object.__setattr__(self, "modeled", bool(modeled))
+        who = type(self).__name__ + (f" {name!r}" if name else "")
+        if bodies is not None:
+            bodies = distinct_bodies(check_sequence(bodies, f"{who}: bodies"), who)
+        object.__setattr__(self, "_bodies", bodies)
+        object.__setattr__(self, "modeled", strict_bool(modeled, f"{who}: modeled"))
         object.__setattr__(self, "_name", name or type(self).__name__)
 
     @property
