@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from gmuk._validation import FloatArray, all_finite, as_array, check_se3, finite_result
-from gmuk.errors import NotOnGroupError
+from gmuk.errors import DomainError, NotOnGroupError
 from gmuk.lie import _kernels
 from gmuk.lie import so3 as _so3
 
@@ -239,14 +239,36 @@ def dexp_inv(xi: Any) -> FloatArray:
     -------
     ndarray, shape (..., 6, 6)
 
+    Raises
+    ------
+    DomainError
+        If some ‖θ‖ ≥ 2π: dexp is singular at ‖θ‖ = 2π (F₁ has a pole there) and beyond
+        it the series no longer inverts :func:`dexp` on the same branch of log, so numbers
+        returned there would be meaningless. Reduce θ first (``log(exp(ξ))``).
+    ShapeError, NonFiniteError
+        If ``xi`` is not (..., 6) finite real numbers, or the result overflows.
+
     Notes
     -----
     F₁ and F₂ cancel catastrophically as θ → 0 when evaluated as printed; gmuk evaluates
     them through exact rearrangements with Taylor series below θ = 2 (see
     :mod:`gmuk.lie._coeffs`), accurate to round-off for every θ in [0, 2π).
+
+    The check is made here, at the public function; the compiled kernels the integrator
+    calls (:mod:`gmuk.lie._kernels`) are not checked: RKMK stages there keep ‖θ‖ small.
     """
     xi = as_array(xi, (6,), "xi")
+    theta = np.sqrt(np.einsum("...i,...i->...", xi[..., :3], xi[..., :3]))
+    if not np.all(theta < _TWO_PI):  # theta is finite: xi is, and |θ| ≤ √3 · 1.8e308 → inf
+        worst = float(np.max(theta))
+        raise DomainError(
+            f"se3.dexp_inv is defined for ‖θ‖ < 2π (6.283185307179586) rad; got ‖θ‖ = "
+            f"{worst!r} rad (reduce ξ first, e.g. se3.log(se3.exp(ξ)))"
+        )
     return finite_result(_dexp_inv(xi), "se3.dexp_inv", "xi", xi)
+
+
+_TWO_PI = 2.0 * np.pi
 
 
 def _dexp(xi: FloatArray) -> FloatArray:
