@@ -382,6 +382,100 @@ def distinct_bodies(bodies: Any, who: str) -> tuple[Any, ...]:
     return items
 
 
+def strict_integer(
+    value: Any,
+    name: str,
+    *,
+    minimum: int | None = None,
+    maximum: int | None = None,
+    integral_floats: bool = False,
+    error: type[Exception] | None = None,
+) -> int:
+    """``value`` as an int, refusing what is not an integer: bool, str, bytes, complex,
+    None, arrays, NaN, inf and fractional numbers (never truncated or parsed).
+
+    Parameters
+    ----------
+    value : int
+        The input; ``numpy`` integers pass, and with ``integral_floats`` also floats with
+        an integral value (``10.0``).
+    name : str
+        Name used in error messages.
+    minimum, maximum : int, optional
+        Inclusive bounds.
+    integral_floats : bool
+        Whether floats of integral value are taken.
+    error : type, optional
+        Exception raised (default :class:`gmuk.errors.DefinitionError`), naming ``name``,
+        what was expected and what came in.
+    """
+    import operator
+
+    from gmuk.errors import DefinitionError
+
+    exc = error or DefinitionError
+    if minimum is not None and maximum is not None:
+        kind = f"an integer in [{minimum}, {maximum}]"
+    elif minimum is not None:
+        kind = f"an integer ≥ {minimum}"
+    elif maximum is not None:
+        kind = f"an integer ≤ {maximum}"
+    else:
+        kind = "an integer"
+    n: int | None = None
+    if not isinstance(value, NOT_REAL) and value is not None:
+        try:
+            n = operator.index(value)
+        except TypeError:
+            if (
+                integral_floats
+                and isinstance(value, (float, np.floating))
+                and np.isfinite(value)
+                and float(value).is_integer()
+            ):
+                n = int(value)
+    if n is None:
+        raise exc(f"{name} must be {kind}; got {type(value).__name__} {value!r:.60}")
+    if (minimum is not None and n < minimum) or (maximum is not None and n > maximum):
+        raise exc(f"{name} must be {kind}; got {n}")
+    return n
+
+
+def real_sequence(
+    x: Any, name: str, *, min_size: int = 0, error: type[Exception] | None = None
+) -> FloatArray:
+    """``x`` as a finite 1-D float64 array of at least ``min_size`` entries.
+
+    Stricter than :func:`as_array` about what it takes: a string, booleans (also inside a
+    list, where numpy would read ``True`` as 1), complex numbers and arrays of more than
+    one axis are refused, never flattened or converted.
+
+    Raises ``error`` (default :class:`gmuk.errors.DefinitionError`) naming ``name``, what
+    was expected and what came in.
+    """
+    from gmuk.errors import DefinitionError
+
+    exc = error or DefinitionError
+    count = f"at least {min_size} " if min_size > 1 else ""
+    want = f"{name} must be a 1-D sequence of {count}finite real numbers"
+    if isinstance(x, (list, tuple)):
+        bad = next((v for v in x if isinstance(v, NOT_REAL) or v is None), x)
+        if bad is not x:
+            raise exc(f"{want}; an entry is {type(bad).__name__} {bad!r:.40}")
+    if isinstance(x, NOT_REAL) or x is None:
+        raise exc(f"{want}; got {type(x).__name__} {x!r:.60}")
+    try:
+        a = _real_float64(x, (), name, True)
+    except (ShapeError, NonFiniteError) as e:
+        raise exc(f"{want}; {e}") from None
+    if a.ndim != 1 or a.size < min_size:
+        raise exc(f"{want}; got an array of shape {a.shape}")
+    if not all_finite(a):
+        bad_n = int(a.size - np.count_nonzero(np.isfinite(a)))
+        raise exc(f"{want}; got {bad_n} NaN/inf entr{'y' if bad_n == 1 else 'ies'}")
+    return a
+
+
 def _holds_not_real(value: Any) -> bool:
     """Whether a list or tuple (nested) holds a bool, complex number or string, which numpy
     would convert along with its real neighbours."""

@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, as_array, real_number, real_sequence
 from gmuk.errors import DefinitionError
 
 __all__ = [
@@ -84,8 +84,17 @@ def legendre(p: int, x: FloatArray) -> tuple[FloatArray, FloatArray]:
     Returns
     -------
     P, dP : ndarray, the shape of x
+
+    Raises
+    ------
+    DefinitionError
+        For a degree that is not an integer in [0, 400].
+    ShapeError, NonFiniteError
+        For points that are not finite real numbers.
     """
-    x = np.asarray(x, dtype=float)
+    if not (isinstance(p, (int, np.integer)) and not isinstance(p, bool) and p == 0):
+        p = _degree(p)
+    x = as_array(x, (), "points x")
     p0, p1 = np.ones_like(x), x.copy()
     d0, d1 = np.zeros_like(x), np.ones_like(x)
     if p == 0:
@@ -136,9 +145,20 @@ def lgl_nodes(p: int) -> tuple[FloatArray, FloatArray]:
     return _nodes_weights(_degree(p))
 
 
+def _nodes(x: Any) -> FloatArray:
+    """Interpolation nodes: a 1-D sequence of at least one finite, distinct real number."""
+    a = real_sequence(x, "interpolation nodes x", min_size=1)
+    if np.unique(a).size != a.size:
+        raise DefinitionError(f"interpolation nodes x must be distinct; got {x!r:.80}")
+    return a
+
+
 def barycentric_weights(x: FloatArray) -> FloatArray:
-    """Barycentric weights ``1/Π_{k≠j}(x_j − x_k)`` of distinct nodes, scaled to max 1."""
-    x = np.asarray(x, dtype=float)
+    """Barycentric weights ``1/Π_{k≠j}(x_j − x_k)`` of distinct nodes, scaled to max 1.
+
+    ``x`` is a 1-D sequence of at least one finite, distinct real number (else
+    :class:`DefinitionError`)."""
+    x = _nodes(x)
     diff = x[:, None] - x[None, :]
     np.fill_diagonal(diff, 1.0)
     # products in log form would lose the sign; scaling each factor by 2/(range) keeps
@@ -156,12 +176,21 @@ def interpolation_matrix(x: FloatArray, y: FloatArray) -> FloatArray:
     Parameters
     ----------
     x : ndarray (n,)
-        Distinct nodes.
-    y : ndarray (m,)
-        Evaluation points.
+        Distinct, finite nodes (n ≥ 1).
+    y : float or ndarray (m,)
+        Finite evaluation points.
+
+    Raises
+    ------
+    DefinitionError
+        For nodes or points that are not finite real numbers of these shapes, or nodes
+        that repeat.
     """
-    x = np.asarray(x, dtype=float)
-    y = np.atleast_1d(np.asarray(y, dtype=float))
+    x = _nodes(x)
+    if np.ndim(y) == 0 and not isinstance(y, (str, bytes)):
+        y = np.array([real_number(y, "evaluation point y")])
+    else:
+        y = real_sequence(y, "evaluation points y")
     b = barycentric_weights(x)
     diff = y[:, None] - x[None, :]
     exact = diff == 0.0
