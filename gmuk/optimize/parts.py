@@ -53,6 +53,11 @@ __all__ = ["register_casadi_form"]
 
 _FORMS: dict[tuple[type, str], Callable[..., Any]] = {}
 
+#: The protocol's method names (the table above).
+_PROTOCOL = frozenset(
+    ("casadi_force", "casadi_wrench", "casadi_wrenches", "casadi_value", "casadi_residual")
+)
+
 
 def register_casadi_form(cls: type, method: str) -> Callable[[Callable[..., Any]], Any]:
     """Register the CasADi form of ``method`` for the parts of exactly class ``cls``.
@@ -65,6 +70,12 @@ def register_casadi_form(cls: type, method: str) -> Callable[[Callable[..., Any]
     method : str
         One of the protocol's names (``"casadi_force"``, ``"casadi_wrench"``,
         ``"casadi_value"``, ``"casadi_residual"``, ``"casadi_wrenches"``).
+
+    Raises
+    ------
+    DefinitionError
+        For a ``cls`` that is not a ForceModel or Constraint class, another ``method``, or
+        a decorated object that is not callable.
 
     Returns
     -------
@@ -79,7 +90,24 @@ def register_casadi_form(cls: type, method: str) -> Callable[[Callable[..., Any]
     ...     return -model.c * ca.norm_2(v_N) * v_N
     """
 
+    from gmuk.constraints.base import Constraint
+
+    if not isinstance(cls, type) or not issubclass(cls, (ForceModel, Constraint)):
+        raise DefinitionError(
+            "register_casadi_form needs a ForceModel or Constraint class; got "
+            f"{type(cls).__name__} {cls!r:.60}"
+        )
+    if method not in _PROTOCOL:
+        raise DefinitionError(
+            f"register_casadi_form: method must be one of {sorted(_PROTOCOL)}; got {method!r:.60}"
+        )
+
     def deco(fn: Callable[..., Any]) -> Any:
+        if not callable(fn):
+            raise DefinitionError(
+                f"register_casadi_form({cls.__name__}, {method!r}) decorates a function "
+                f"fn(part, *args); got {type(fn).__name__}"
+            )
         _FORMS[(cls, method)] = fn
         return fn
 

@@ -56,7 +56,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk._casadi import casadi
-from gmuk._validation import FloatArray, as_array, check_se3, real_number
+from gmuk._validation import FloatArray, as_array, check_se3, real_number, strict_integer
 from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.inequality import InequalityConstraint
 from gmuk.errors import DefinitionError, OptimizationError
@@ -74,6 +74,21 @@ __all__ = ["OptimalControlProblem"]
 
 #: Relative tolerance of the checks of boundary conditions against the path constraints.
 BOUNDARY_TOL = 1e-9
+
+#: Sizes (elements) of the partial meshes on which :meth:`OptimalControlProblem.solve` times
+#: the build of a larger mesh before building it (see ``_check_build_time``).
+CALIBRATION_ELEMENTS = (16, 64)
+
+#: Factor on the build time extrapolated from the partial meshes (see above).
+BUILD_MARGIN = 1.5
+
+#: IPOPT options set by :meth:`OptimalControlProblem.solve`'s own arguments.
+_RESERVED_OPTIONS = {
+    "max_iter": "max_iter",
+    "max_cpu_time": "max_cpu_time",
+    "max_wall_time": "max_cpu_time",
+    "tol": "tol",
+}
 
 CostFunction = Callable[[float, tuple[Any, ...], tuple[Any, ...], tuple[Any, ...]], Any]
 
@@ -258,14 +273,22 @@ class OptimalControlProblem:
                 raise DefinitionError(
                     f"final conditions take the keys 'g', 'V', 'r', 'v'; got {sorted(unknown)}"
                 )
-            spec = {k: dict(final.get(k) or {}) for k in ("g", "V", "r", "v")}
+            spec = {}
+            for k in ("g", "V", "r", "v"):
+                entry = final.get(k)
+                if entry is not None and not isinstance(entry, Mapping):
+                    raise DefinitionError(
+                        f"final[{k!r}] must be a mapping body name → value (or None); got "
+                        f"{type(entry).__name__} {entry!r:.60}"
+                    )
+                spec[k] = dict(entry or {})
         else:
             raise DefinitionError(
                 f"final must be a State, a mapping or None; got {type(final).__name__}"
             )
         for key, values in spec.items():
             for name, value in values.items():
-                plan = self._by_name.get(name)
+                plan = self._by_name.get(name) if isinstance(name, str) else None
                 if plan is None:
                     raise DefinitionError(
                         f"final[{key!r}] names unknown body {name!r}; bodies are "
@@ -410,11 +433,6 @@ class OptimalControlProblem:
             if p.rigid
         ]
 
-    # ------------------------------------------------------------------ transcription
-    def transcribe(self, mesh: Mesh) -> _Transcription:
-        """Build the NLP on ``mesh`` (no solve); see :meth:`solve`."""
-        return _Transcription(self, mesh)
-
     def solve(
         self,
         mesh: Mesh | None = None,
@@ -428,7 +446,7 @@ class OptimalControlProblem:
         log: bool = False,
         ipopt_options: Mapping[str, Any] | None = None,
     ) -> OptimalControlResult:
-        """Transcribe on ``mesh`` and solve with IPOPT.
+        """Transcribe on ``mesh`` and solve with IPOPT, within ``max_cpu_time``.
 
         Parameters
         ----------
@@ -437,19 +455,24 @@ class OptimalControlProblem:
         n_elements, degree : int
             Used when ``mesh`` is not given.
         guess : OptimalControlResult, optional
-            A previous solution (any mesh) to start from; default: the initial state held
-            (moved linearly, and rotated about one axis, towards given final conditions).
+            A previous solution of a problem with the same bodies (any mesh covering
+            [t0, tf]) to start from; default: the initial state held (moved linearly, and
+            rotated about one axis, towards given final conditions).
         max_iter : int
-            IPOPT's iteration limit.
+            IPOPT's iteration limit, an integer in [0, 2³¹ − 1].
         max_cpu_time : float
-            IPOPT's CPU-time limit (s); also its wall-time limit. The solve never runs
-            longer.
+            The time budget (s) of the whole call, building the NLP and solving it: IPOPT
+            gets what the build left as its CPU- and wall-time limits. A mesh of more than
+            64 elements is first timed on 16 (and 64) of its elements, and refused up
+            front when building it all would not fit in the budget; the build checks the
+            clock as it goes. The call returns or raises within about ``max_cpu_time``.
         tol : float
-            IPOPT's convergence tolerance.
+            IPOPT's convergence tolerance (> 0).
         log : bool
             Keep IPOPT's iteration log in ``result.log`` (it is never printed).
         ipopt_options : mapping, optional
-            Further IPOPT options (``{"mu_strategy": "adaptive"}``, ...).
+            Further IPOPT options, name → str, int or float (``{"mu_strategy":
+            "adaptive"}``, ...). The limits above are set by their own arguments, not here.
 
         Returns
         -------
@@ -457,24 +480,24 @@ class OptimalControlProblem:
 
         Raises
         ------
+        DefinitionError
+            For arguments not as above (checked before anything is built).
         OptimizationError
             When IPOPT does not converge; ``status`` is its return status and ``result``
-            the last iterate.
+            the last iterate. With status ``"Maximum_CpuTime_Exceeded"`` and no result
+            when the budget is spent (or would be) building the NLP.
         """
+        budget = _Budget(real_number(max_cpu_time, "max_cpu_time (s)", positive=True))
+        settings = _solver_settings(max_iter, tol, log, ipopt_options)
         if mesh is None:
             mesh = Mesh.uniform(self.t0, self.tf, n_elements, degree)
-        tic = time.perf_counter()
-        tr = self.transcribe(mesh)
-        built = time.perf_counter() - tic
-        result = tr.solve(
-            guess=guess,
-            max_iter=max_iter,
-            max_cpu_time=max_cpu_time,
-            tol=tol,
-            log=log,
-            ipopt_options=ipopt_options,
-            transcription_s=built,
-        )
+        if not isinstance(mesh, Mesh):
+            raise DefinitionError(f"mesh must be a gmuk.optimize.Mesh; got {type(mesh).__name__}")
+        self._check_guess(guess)
+        self._check_build_time(mesh, budget)
+        tr = _Transcription(self, mesh, budget=budget)
+        budget.built = budget.elapsed()
+        result = tr.solve(guess=guess, budget=budget, **settings)
         if not result.success:
             raise OptimizationError(
                 f"IPOPT did not solve the problem: {result.status} after {result.iterations} "
@@ -485,6 +508,83 @@ class OptimalControlProblem:
                 result,
             )
         return result
+
+    def _check_guess(self, guess: Any) -> None:
+        """A guess is None or the result of a problem with these bodies, finite, covering
+        [t0, tf]."""
+        if guess is None:
+            return
+        if not isinstance(guess, OptimalControlResult):
+            raise DefinitionError(
+                "guess must be an OptimalControlResult (a previous solve of a problem with "
+                f"the same bodies) or None; got {type(guess).__name__}"
+            )
+        mine = [(p.body.name, str(p.body.kind), p.body.dof) for p in self._plans]
+        theirs = list(zip(guess.body_names, guess.body_kinds, guess.body_dofs, strict=False))
+        nr = self.n_th // 3
+        if (
+            theirs != mine
+            or guess.y.shape[1:] != (self.n_y,)
+            or guess.u.shape[1:] != (self.n_u,)
+            or guess.R_NB.shape[1:] != (nr, 3, 3)
+        ):
+            raise DefinitionError(
+                "guess is the result of a problem with other bodies: its bodies (name, kind, "
+                f"dof) are {theirs}; this problem's are {mine}"
+            )
+        lo = self.t0 + 1e-9 * max(1.0, abs(self.t0))
+        hi = self.tf - 1e-9 * max(1.0, abs(self.tf))
+        if guess.mesh.t0 > lo or guess.mesh.tf < hi:
+            raise DefinitionError(
+                f"guess spans [{guess.mesh.t0:g}, {guess.mesh.tf:g}] s; it must cover the "
+                f"problem's span [{self.t0:g}, {self.tf:g}] s"
+            )
+        arrays = (guess.y, guess.u, guess.theta, guess.element_R)
+        if not all(np.all(np.isfinite(a)) for a in arrays):
+            raise DefinitionError(
+                f"guess holds NaN or inf (its solve ended with status {guess.status!r}); "
+                "start from a finite result or from the default guess"
+            )
+
+    def _check_build_time(self, mesh: Mesh, budget: _Budget) -> None:
+        """Refuse up front a mesh whose NLP would not be built within the budget.
+
+        Building the NLP (CasADi's derivatives and IPOPT's set-up, one call each that
+        cannot be interrupted) costs about the same per element; it is timed on the first
+        16 elements and, if those suggest the whole might not fit, on the first 64, and
+        the mean cost per element extrapolated to the mesh."""
+        K = mesh.n_elements
+        if K <= CALIBRATION_ELEMENTS[-1]:
+            return
+        small, large = CALIBRATION_ELEMENTS
+        t_small, nlp_small = _time_build(self, mesh, small)
+        estimate = t_small / small * K  # an over-estimate: fixed costs counted per element
+        budget.reserve = nlp_small / small * K
+        timed_on = small
+        if estimate <= 0.5 * budget.remaining():
+            return
+        if 4.0 * t_small < 0.5 * budget.remaining():
+            t_large, nlp_large = _time_build(self, mesh, large)
+            # the mean cost per element, not the slope between the two, and a margin: the
+            # cost per element still grows with the mesh (measured for one point mass:
+            # 1.2 ms at 64 elements, 1.3 ms at 10⁴, 1.6 ms or more at 5·10⁴)
+            estimate = BUILD_MARGIN * t_large / large * K
+            budget.reserve = BUILD_MARGIN * nlp_large / large * K
+            timed_on = large
+        if estimate > budget.remaining():
+            raise OptimizationError(
+                f"a mesh of {K} elements would take about {estimate:.3g} s to build (timed "
+                f"on its first {timed_on} elements), more than the time budget "
+                f"max_cpu_time = {budget.total:g} s "
+                f"leaves ({max(budget.remaining(), 0.0):.3g} s): use fewer elements or raise "
+                "max_cpu_time",
+                "Maximum_CpuTime_Exceeded",
+            )
+
+    # ------------------------------------------------------------------ transcription
+    def transcribe(self, mesh: Mesh) -> _Transcription:
+        """Build the NLP on ``mesh`` (no solve, no time budget); see :meth:`solve`."""
+        return _Transcription(self, mesh)
 
     def solve_adaptive(
         self,
@@ -515,25 +615,27 @@ class OptimalControlProblem:
         tol : float
             Target relative error per element.
         max_rounds : int
-            Solves at most (the last result is returned even if above ``tol``; its
+            Solves at most, ≥ 1 (the last result is returned even if above ``tol``; its
             ``refinement`` history says so).
         max_elements : int
             Stop refining before a mesh would exceed this many elements.
         options
-            Passed to :meth:`solve`.
+            Passed to :meth:`solve`; ``max_cpu_time`` is the budget of each solve.
 
         Returns
         -------
         OptimalControlResult
             The last solve's, with ``refinement`` the list of :class:`RefinementStep`.
         """
+        tol = real_number(tol, "tol", positive=True)
+        rounds = strict_integer(max_rounds, "max_rounds", minimum=1)
+        most = strict_integer(max_elements, "max_elements", minimum=1)
         if mesh is None:
             mesh = Mesh.uniform(self.t0, self.tf, n_elements, degree)
-        tol = real_number(tol, "tol", positive=True)
         history: list[RefinementStep] = []
         guess = options.pop("guess", None)
         result = None
-        for rnd in range(int(max_rounds)):
+        for rnd in range(rounds):
             result = self.solve(mesh, guess=guess, **options)
             errors = _Transcription(self, mesh, build=False).element_errors(result)
             emax = float(errors.max())
@@ -551,7 +653,7 @@ class OptimalControlProblem:
             if emax <= tol:
                 break
             counts = split_counts(errors, tol, mesh.degrees)
-            if mesh.n_elements + sum(c - 1 for c in counts) > max_elements:
+            if mesh.n_elements + sum(c - 1 for c in counts) > most:
                 break
             mesh, guess = mesh.split(counts), result
         assert result is not None
@@ -561,12 +663,24 @@ class OptimalControlProblem:
 class _Transcription:
     """The NLP of a problem on one mesh (CasADi symbols, bounds, index maps)."""
 
-    def __init__(self, problem: OptimalControlProblem, mesh: Mesh, build: bool = True) -> None:
+    def __init__(
+        self,
+        problem: OptimalControlProblem,
+        mesh: Mesh,
+        build: bool = True,
+        *,
+        budget: _Budget | None = None,
+        part: bool = False,
+    ) -> None:
+        """``part``: a mesh of the first elements only (to time the build, see
+        :meth:`OptimalControlProblem._check_build_time`); ``budget``: the clock to check."""
         if not isinstance(mesh, Mesh):
             raise DefinitionError(f"mesh must be a gmuk.optimize.Mesh; got {type(mesh).__name__}")
-        if abs(mesh.t0 - problem.t0) > 1e-12 * max(1.0, abs(problem.t0)) or abs(
+        self.budget = budget or _Budget(float("inf"))
+        off = abs(mesh.t0 - problem.t0) > 1e-12 * max(1.0, abs(problem.t0)) or abs(
             mesh.tf - problem.tf
-        ) > 1e-12 * max(1.0, abs(problem.tf)):
+        ) > 1e-12 * max(1.0, abs(problem.tf))
+        if off and not part:
             raise DefinitionError(
                 f"the mesh spans [{mesh.t0:g}, {mesh.tf:g}] s; the problem [{problem.t0:g}, "
                 f"{problem.tf:g}] s"
@@ -597,9 +711,11 @@ class _Transcription:
                 self.mapped = True
             except DefinitionError:
                 self.mapped = False  # a part needs a numeric time: one expression per node
+        self.budget.check("transcribing")
         if not self.mapped:
             self._build_unrolled()
             self._check_finite()
+            self.budget.check("transcribing")
         # variable bounds: initial state, given final entries, θ and φ per element (φ₀ = 0)
         lbx = np.full(self.n_x, -np.inf)
         ubx = np.full(self.n_x, np.inf)
@@ -729,10 +845,12 @@ class _Transcription:
         )
         if not all(np.all(np.isfinite(np.asarray(v))) for v in sample):
             raise DefinitionError("a part is not finite with a symbolic time")
+        self.budget.check("transcribing")
         X, P, Y, U, TH, PHI, RBAR = self._symbols(ca.MX)
         idx = [k * p + j for k in range(K) for j in range(p + 1)]
         T = ca.DM(np.asarray(self.times)[idx].reshape(K, p + 1).T)
         out = fn.map(K)(RBAR, PHI, Y[:, idx], U[:, idx], TH, T)
+        self.budget.check("transcribing")
         self._assemble(
             X, P, U, out[0], out[1], ca.vec(out[2]), out[3], [ca.vec(o) for o in out[4:]]
         )
@@ -746,8 +864,9 @@ class _Transcription:
         X, P, Y, U, TH, PHI, RBAR = self._symbols(ca.SX)
         outs = []
         col = 0
+        i0 = 0
         for k, p in enumerate(mesh.degrees):
-            i0 = mesh.first_node(k)
+            self.budget.check(f"transcribing element {k} of {mesh.n_elements}")
             outs.append(
                 self._element(
                     p,
@@ -760,6 +879,7 @@ class _Transcription:
                 )
             )
             col += p
+            i0 += p
         self._assemble(
             X,
             P,
@@ -941,9 +1061,10 @@ class _Transcription:
             Rg[0] = np.array(pb.R0)  # the start is given
         TH = np.zeros((pb.n_th, self.n_th_cols))
         Rbar = np.zeros((mesh.n_elements, nr, 3, 3))
-        col = 0
+        col = i0 = 0
         for k, deg in enumerate(mesh.degrees):
-            i0 = mesh.first_node(k)
+            if nr:
+                self.budget.check(f"computing the starting point, element {k}")
             for b in range(nr):
                 Rbar[k, b] = _orthonormal(Rg[i0, b])
             for j in range(1, deg + 1):
@@ -953,6 +1074,7 @@ class _Transcription:
                         d, -pb.max_element_rotation, pb.max_element_rotation
                     )
             col += deg
+            i0 += deg
         x0 = np.concatenate(
             [
                 Yg.reshape(-1),
@@ -970,20 +1092,22 @@ class _Transcription:
         self,
         *,
         guess: OptimalControlResult | None,
+        budget: _Budget,
         max_iter: int,
-        max_cpu_time: float,
         tol: float,
         log: bool,
-        ipopt_options: Mapping[str, Any] | None,
-        transcription_s: float,
+        ipopt_options: Mapping[str, Any],
     ) -> OptimalControlResult:
+        """Solve with arguments checked by :func:`_solver_settings`; IPOPT gets what is left
+        of ``budget`` (less the expected cost of building the solver)."""
         import casadi as ca
 
-        if isinstance(max_iter, bool) or int(max_iter) != max_iter or max_iter < 0:
-            raise DefinitionError(f"max_iter must be an integer ≥ 0; got {max_iter!r}")
-        cpu = real_number(max_cpu_time, "max_cpu_time (s)", positive=True)
-        tol = real_number(tol, "tol", positive=True)
+        x0, pbar = self.initial_guess(guess)
+        x0 = np.clip(x0, self.lbx, self.ubx)
         tic = time.perf_counter()
+        left = budget.remaining() - budget.reserve
+        budget.check("computing the starting point")
+        cpu = max(left, 1e-3 * budget.total)
         log_path = None
         opts: dict[str, Any] = {
             "print_time": False,
@@ -999,16 +1123,21 @@ class _Transcription:
             os.close(fd)
             opts["ipopt.output_file"] = log_path
             opts["ipopt.file_print_level"] = 5
-        for k, v in (ipopt_options or {}).items():
-            opts[k if k.startswith("ipopt.") else f"ipopt.{k}"] = v
+        opts.update(ipopt_options)
         nlp = {"x": self.x, "p": self.p, "f": self.f, "g": self.g}
         try:
             solver = ca.nlpsol("gmuk", "ipopt", nlp, opts)
-        except RuntimeError as exc:
+        except (RuntimeError, TypeError, NotImplementedError) as exc:
+            if log_path is not None:
+                os.unlink(log_path)
             raise DefinitionError(f"CasADi refused the IPOPT options: {exc}") from None
-        x0, pbar = self.initial_guess(guess)
-        x0 = np.clip(x0, self.lbx, self.ubx)
         setup = time.perf_counter() - tic
+        try:
+            budget.check("building the solver (CasADi's derivatives)")
+        except OptimizationError:
+            if log_path is not None:
+                os.unlink(log_path)
+            raise
         tic = time.perf_counter()
         out = solver(x0=x0, p=pbar, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         solve_s = time.perf_counter() - tic
@@ -1028,9 +1157,9 @@ class _Transcription:
             k: np.asarray(iters.get(k, []), dtype=float) for k in ("obj", "inf_pr", "inf_du", "mu")
         }
         timings = {
-            "transcription_s": transcription_s + setup,
+            "transcription_s": budget.built + setup,
             "solve_s": solve_s,
-            "total_s": transcription_s + setup + solve_s,
+            "total_s": budget.built + setup + solve_s,
         }
         return self._result(
             x, pbar, lam_g, lam_x, gval, float(out["f"]), stats, history, text, timings, viol
@@ -1281,6 +1410,100 @@ class _KKTEvaluator:
             "complementarity": comp,
             "dual_violation": dual,
         }
+
+
+class _Budget:
+    """The wall-clock budget of one :meth:`OptimalControlProblem.solve` (s), from its
+    start: ``reserve`` is the expected cost of building the solver, ``built`` the time the
+    transcription took."""
+
+    def __init__(self, total: float) -> None:
+        self.total = total
+        self.start = time.perf_counter()
+        self.reserve = 0.0
+        self.built = 0.0
+
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.start
+
+    def remaining(self) -> float:
+        return self.total - self.elapsed()
+
+    def check(self, stage: str) -> None:
+        """An :class:`OptimizationError` if the budget is spent (while ``stage``)."""
+        if self.remaining() <= 0.0:
+            raise OptimizationError(
+                f"the time budget max_cpu_time = {self.total:g} s was spent building the NLP "
+                f"({self.elapsed():.3g} s, {stage}) before IPOPT started: use fewer elements "
+                "or raise max_cpu_time",
+                "Maximum_CpuTime_Exceeded",
+            )
+
+
+def _solver_settings(max_iter: Any, tol: Any, log: Any, ipopt_options: Any) -> dict[str, Any]:
+    """The solver arguments of :meth:`OptimalControlProblem.solve`, checked."""
+    n_iter = strict_integer(
+        max_iter, "max_iter", minimum=0, maximum=2**31 - 1, integral_floats=True
+    )
+    tol_ = real_number(tol, "tol", positive=True)
+    if not isinstance(log, (bool, np.bool_)):
+        raise DefinitionError(f"log must be True or False; got {type(log).__name__} {log!r:.40}")
+    if ipopt_options is None:
+        ipopt_options = {}
+    if not isinstance(ipopt_options, Mapping):
+        raise DefinitionError(
+            "ipopt_options must be a mapping of IPOPT option names to values, e.g. "
+            f'{{"mu_strategy": "adaptive"}}; got {type(ipopt_options).__name__} '
+            f"{ipopt_options!r:.60}"
+        )
+    opts: dict[str, Any] = {}
+    for key, value in ipopt_options.items():
+        if not isinstance(key, str) or not key.removeprefix("ipopt."):
+            raise DefinitionError(f"IPOPT option names must be non-empty strings; got {key!r:.40}")
+        name = key.removeprefix("ipopt.")
+        if name in _RESERVED_OPTIONS:
+            raise DefinitionError(
+                f"IPOPT's {name!r} is set by solve's own argument "
+                f"{_RESERVED_OPTIONS[name]}=, not through ipopt_options"
+            )
+        if isinstance(value, (bool, np.bool_)) or not isinstance(
+            value, (str, int, float, np.integer, np.floating)
+        ):
+            raise DefinitionError(
+                f"IPOPT option {name!r} must be a string, an integer or a number (IPOPT "
+                f'spells yes/no as "yes"/"no"); got {type(value).__name__} {value!r:.40}'
+            )
+        if isinstance(value, (float, np.floating)):
+            if value != value:
+                raise DefinitionError(f"IPOPT option {name!r} must not be NaN")
+            value = float(value)
+        elif isinstance(value, np.integer):
+            value = int(value)
+        opts[f"ipopt.{name}"] = value
+    return {"max_iter": n_iter, "tol": tol_, "log": bool(log), "ipopt_options": opts}
+
+
+def _time_build(problem: OptimalControlProblem, mesh: Mesh, n: int) -> tuple[float, float]:
+    """Seconds to build the NLP, the starting point, the solver and IPOPT's set-up (no
+    iteration) on the first ``n`` elements of ``mesh``; and the part of it spent building
+    the solver and setting IPOPT up."""
+    import casadi as ca
+
+    tic = time.perf_counter()
+    part = Mesh(mesh.breaks[: n + 1], mesh.degrees[:n], max_nodes=mesh.n_nodes)
+    tr = _Transcription(problem, part, part=True)
+    x0, p = tr.initial_guess(None)
+    mid = time.perf_counter()
+    opts: dict[str, Any] = {
+        "print_time": False,
+        "ipopt.print_level": 0,
+        "ipopt.sb": "yes",
+        "ipopt.max_iter": 0,
+    }
+    solver = ca.nlpsol("timing", "ipopt", {"x": tr.x, "p": tr.p, "f": tr.f, "g": tr.g}, opts)
+    solver(x0=np.clip(x0, tr.lbx, tr.ubx), p=p, lbx=tr.lbx, ubx=tr.ubx, lbg=tr.lbg, ubg=tr.ubg)
+    end = time.perf_counter()
+    return end - tic, end - mid
 
 
 def _skew_vee(E: Any) -> Any:

@@ -276,14 +276,8 @@ class OptimalControlResult:
     # ------------------------------------------------------------------ interpolation
     def _per_element(self, t: Any, values: FloatArray) -> FloatArray:
         """The degree-p interpolant of nodal ``values`` (N, m) in each element, at t."""
-        tt = np.atleast_1d(np.asarray(t, dtype=float))
         mesh = self.mesh
-        if np.any(tt < mesh.t0 - 1e-9 * max(1.0, abs(mesh.t0))) or np.any(
-            tt > mesh.tf + 1e-9 * max(1.0, abs(mesh.tf))
-        ):
-            raise DefinitionError(
-                f"times must lie in [{mesh.t0:g}, {mesh.tf:g}] s; got [{tt.min():g}, {tt.max():g}]"
-            )
+        tt = mesh.check_times(t)
         out = np.zeros((tt.size, values.shape[1]))
         elements = mesh.element_of(tt)
         for k in np.unique(elements):
@@ -295,7 +289,8 @@ class OptimalControlResult:
 
     def control(self, t: Any) -> FloatArray:
         """u at times t: (n_u,) for a scalar t, (len(t), n_u) otherwise; the degree-p
-        interpolant of the nodal controls in the element holding each time."""
+        interpolant of the nodal controls in the element holding each time. Times must be
+        finite and within the mesh's span (else :class:`DefinitionError`)."""
         out = self._per_element(t, self.u)
         return out[0] if np.ndim(t) == 0 else out
 
@@ -308,8 +303,8 @@ class OptimalControlResult:
 
     def attitudes_at(self, t: Any) -> FloatArray:
         """Attitudes (len(t), n_rigid, 3, 3) at times t: the element's θ interpolated,
-        then ``R_k exp(θ^)``."""
-        tt = np.atleast_1d(np.asarray(t, dtype=float))
+        then ``R_k exp(θ^)``. Times must be finite and within the mesh's span."""
+        tt = self.mesh.check_times(t)
         nr = self.R_NB.shape[1]
         if nr == 0:
             return np.zeros((tt.size, 0, 3, 3))
@@ -319,7 +314,7 @@ class OptimalControlResult:
         for k in np.unique(elements):
             sel = elements == k
             p = mesh.degrees[int(k)]
-            c0 = sum(mesh.degrees[: int(k)])
+            c0 = mesh.first_node(int(k))
             th = np.zeros((p + 1, 3 * nr))
             th[1:] = self.theta[c0 : c0 + p]
             th_t = interpolation_matrix(mesh.element_times(int(k)), tt[sel]) @ th
@@ -382,6 +377,13 @@ class OpenLoopControl(Controller):
     )
 
     def __init__(self, result: OptimalControlResult, *, name: str = "optimal control") -> None:
+        if not isinstance(result, OptimalControlResult):
+            raise DefinitionError(
+                "OpenLoopControl needs an OptimalControlResult (OptimalControlProblem.solve's "
+                f"result); got {type(result).__name__}"
+            )
+        if not isinstance(name, str) or not name:
+            raise DefinitionError(f"a controller's name must be a non-empty str; got {name!r:.60}")
         super().__init__(list(result.body_names), name=name)
         self.result = result
         offsets = np.concatenate([[0], np.cumsum(result.body_dofs)])
