@@ -12,13 +12,14 @@ computed).
 from __future__ import annotations
 
 import json
+import math
 import os
 import tempfile
 import zipfile
 import zlib
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -345,46 +346,103 @@ def write_text_atomic(path: str | Path, text: str) -> Path:
     return Path(path)
 
 
-def load_trajectory(path: str | Path) -> Trajectory:
+#: Most bytes :func:`load_trajectory` decompresses by default: the sum of the sizes the
+#: archive declares for the members it reads (1 GiB; raise it with ``max_bytes=``).
+MAX_BYTES = 2**30
+#: Deflate expands data at most 1032 times; a member declaring a larger ratio of
+#: uncompressed to compressed size states a false size (a zip bomb or a forged header).
+MAX_COMPRESSION_RATIO = 1100
+#: Most bytes of the JSON metadata member.
+MAX_META_BYTES = 64 * 2**20
+#: Tolerance of the rotation checks on the saved poses: ‖RᵀR − I‖_max, |det R − 1| and the
+#: bottom row's distance to [0, 0, 0, 1]. gmuk's integrator keeps R on SO(3) to round-off
+#: (about 1e-15 per step); a looser bound than :data:`gmuk._validation.GROUP_TOL` lets
+#: files from other programs that store fewer digits load.
+POSE_TOL = 1e-6
+#: The values of :attr:`Trajectory.status`.
+STATUSES = ("success", "interrupted", "failed")
+_DOFS = {"rigid": 6, "point": 3, "slack": 1}
+_META_KEYS = ("format_version", "body_names", "body_kinds", "body_dofs", "status", "message")
+_NPY_MAGIC = b"\x93NUMPY"
+_ZIP_MAGIC = (b"PK\x03\x04", b"PK\x05\x06")
+#: Members of a trajectory ``.npz`` (without ``.npy``): the arrays, the metadata and the
+#: point masses' copies (format version 2).
+_MEMBERS = (*_ARRAYS, "meta", "r_N", "v_N")
+
+
+def load_trajectory(path: str | Path, *, max_bytes: int = MAX_BYTES) -> Trajectory:
     """Load a trajectory saved by :meth:`Trajectory.save`.
 
     Reads every format version up to this gmuk's (:data:`FORMAT_VERSION`; version 1 files,
     written before the ``r_N``/``v_N`` copies, load the same) and refuses newer ones.
 
+    The file is treated as untrusted: everything is checked before it is used, and memory
+    is allocated only for what the archive declares and the checks allow.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.npz`` file.
+    max_bytes : int
+        Most bytes to decompress (the sum of the members' declared uncompressed sizes);
+        default :data:`MAX_BYTES` (1 GiB). A larger file is refused before anything is
+        decompressed; pass a larger value to read it.
+
+    Returns
+    -------
+    Trajectory
+        Arrays bit-identical to those saved.
+
     Raises
     ------
     FileFormatError
-        If the path is not a readable file, the file is not a gmuk trajectory (not an
-        ``.npz``, truncated or corrupted, missing or inconsistent arrays or metadata), or it
-        was written by a newer gmuk (its format version is above this one's).
+        The message names the file and, where it applies, the member and what was expected.
+        Refused are:
+
+        * a path that is not a readable regular file; a ``.npy`` file (one array) or any
+          other file that is not a zip archive; a truncated or corrupted archive (bad CRC);
+        * *allocation before reading*: a member compressed other than stored or deflated,
+          or encrypted; a member whose declared uncompressed size is more than
+          :data:`MAX_COMPRESSION_RATIO` times its compressed size (more than deflate can
+          give: a zip bomb or a forged size); declared sizes summing to more than
+          ``max_bytes``; an array header (shape, dtype) that does not describe exactly the
+          member's declared size (a 300-byte header claiming 10¹² entries is refused
+          before any allocation); object, complex, string, boolean or structured dtypes;
+          the arrays are then read with reads bounded by those checked sizes;
+        * a member that is not part of a trajectory, or given twice; a missing array;
+        * *metadata*: not a JSON object, a ``format_version`` that is not an integer
+          between 1 and :data:`FORMAT_VERSION` (a newer one asks to upgrade gmuk),
+          body names that are not distinct strings, unknown body kinds, ``body_dofs``
+          that are not integers (6.7 is not read as 6) or not those of the body kinds
+          (rigid 6, point 3, slack 1), a ``status`` not in :data:`STATUSES`, a
+          ``message`` that is not a string, ``stats`` that is not an object or whose
+          ``n_rhs``, ``n_steps``, ``n_rejected`` (integers ≥ 0), ``method`` (str),
+          ``rtol``, ``atol`` (finite ≥ 0), ``compiled`` (bool), ``versions`` or
+          ``checkpoint`` (objects) have the wrong type;
+        * *arrays*: shapes that disagree with the bodies or with each other; NaN or
+          infinity; times ``t`` that do not strictly increase; poses whose rotation
+          block is not a rotation (‖RᵀR − I‖ or |det R − 1| above :data:`POSE_TOL`, a
+          reflection included) or whose bottom row is not [0, 0, 0, 1]; a negative
+          ``residual``; a ``rank`` outside [−1, n_dof]; ``r_N``/``v_N`` that are not
+          the point masses' columns of ``x``/``xdot`` (or absent from a version-2 file).
+    DefinitionError
+        ``max_bytes`` is not an integer > 0.
     """
     if not isinstance(path, (str, os.PathLike)):
         raise FileFormatError(f"load_trajectory: path must be a str or os.PathLike; got {path!r}")
+    if isinstance(max_bytes, bool) or not isinstance(max_bytes, (int, np.integer)) or max_bytes < 1:
+        raise DefinitionError(
+            f"load_trajectory: max_bytes must be an integer > 0; got {max_bytes!r}"
+        )
     path = Path(path)
     if not path.is_file():
         raise FileFormatError(
             f"{path}: {'not a regular file' if path.exists() else 'no such file'}"
         )
     try:
-        with np.load(path, allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"]))
-            if not isinstance(meta, dict):
-                raise FileFormatError(f"{path}: metadata is not a JSON object")
-            version = meta.get("format_version")
-            if not isinstance(version, int) or version < 1:
-                raise FileFormatError(
-                    f"{path}: format_version must be a positive integer; got {version!r}"
-                )
-            if version > FORMAT_VERSION:
-                raise FileFormatError(
-                    f"{path}: trajectory format version {version} was written by a newer gmuk; "
-                    f"this one reads versions up to {FORMAT_VERSION}: upgrade gmuk"
-                )
-            arrays: dict[str, Any] = {k: np.asarray(data[k]) for k in _ARRAYS}
+        members = _read_members(path, int(max_bytes))
     except FileFormatError:
         raise
-    except KeyError as exc:
-        raise FileFormatError(f"{path}: not a gmuk trajectory (missing {exc})") from None
     except (
         OSError,
         ValueError,
@@ -398,23 +456,261 @@ def load_trajectory(path: str | Path) -> Trajectory:
             f"{path}: cannot read as a gmuk trajectory .npz (truncated or corrupted?): "
             f"{type(exc).__name__}: {exc}"
         ) from None
-    names = {f.name for f in fields(Trajectory)}
-    kw = {k: v for k, v in meta.items() if k in names}
-    try:
-        body = {
-            "body_names": tuple(str(n) for n in meta["body_names"]),
-            "body_kinds": tuple(str(k) for k in meta["body_kinds"]),
-            "body_dofs": tuple(int(d) for d in meta["body_dofs"]),
-        }
-        traj = Trajectory(**arrays, **{**kw, **body})
-        _check_consistent(traj, path)
-    except FileFormatError:
-        raise
-    except (KeyError, TypeError, ValueError) as exc:
-        raise FileFormatError(
-            f"{path}: inconsistent trajectory metadata or arrays: {type(exc).__name__}: {exc}"
-        ) from None
+    meta = _parse_meta(members.pop("meta"), path)
+    version, body, status, message, stats = _check_meta(meta, path)
+    copies: dict[str, np.ndarray] = {k: members.pop(k) for k in ("r_N", "v_N") if k in members}
+    arrays = _check_dtypes(members, path)
+    traj = Trajectory(**arrays, **body, status=status, message=message, stats=stats)
+    _check_consistent(traj, path)
+    _check_values(traj, path)
+    _check_copies(traj, copies, version, path)
     return traj
+
+
+def _read_members(path: Path, max_bytes: int) -> dict[str, np.ndarray]:
+    """The trajectory's members as arrays, every size checked before it is allocated."""
+    with path.open("rb") as fh:
+        magic = fh.read(8)
+    if magic.startswith(_NPY_MAGIC):
+        raise FileFormatError(
+            f"{path}: a .npy file (a single numpy array), not a gmuk trajectory .npz; "
+            "trajectories are saved by Trajectory.save as .npz archives"
+        )
+    if not magic.startswith(_ZIP_MAGIC):
+        raise FileFormatError(
+            f"{path}: not a gmuk trajectory .npz (not a zip archive: starts with {magic[:4]!r})"
+        )
+    with zipfile.ZipFile(path) as zf:
+        infos: dict[str, zipfile.ZipInfo] = {}
+        for info in zf.infolist():
+            name = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
+            if name not in _MEMBERS:
+                raise FileFormatError(
+                    f"{path}: member {info.filename!r} is not part of a gmuk trajectory "
+                    f"(expected {', '.join(f'{m}.npy' for m in _MEMBERS)})"
+                )
+            if name in infos:
+                raise FileFormatError(f"{path}: member {info.filename!r} appears twice")
+            infos[name] = info
+        missing = [k for k in (*_ARRAYS, "meta") if k not in infos]
+        if missing:
+            raise FileFormatError(
+                f"{path}: not a gmuk trajectory (missing {', '.join(map(repr, missing))})"
+            )
+        total = 0
+        for name, info in infos.items():
+            _check_member_sizes(path, name, info)
+            total += info.file_size
+        if total > max_bytes:
+            raise FileFormatError(
+                f"{path}: the archive declares {total} bytes uncompressed, more than the "
+                f"limit of {max_bytes} (load_trajectory(..., max_bytes=...) raises it); "
+                "nothing was decompressed"
+            )
+        return {name: _read_member(zf, info, path, name) for name, info in infos.items()}
+
+
+def _check_member_sizes(path: Path, name: str, info: zipfile.ZipInfo) -> None:
+    """Refuse, before decompressing, a member whose method or declared sizes are not those
+    of numpy's own (stored or deflated, unencrypted, a ratio deflate can give)."""
+    where = f"{path}: member {info.filename!r}"
+    if info.flag_bits & 0x1:
+        raise FileFormatError(f"{where} is encrypted; gmuk trajectories are not")
+    if info.compress_type == zipfile.ZIP_STORED:
+        if info.file_size != info.compress_size:
+            raise FileFormatError(
+                f"{where} is stored uncompressed but declares {info.file_size} bytes "
+                f"uncompressed and {info.compress_size} compressed"
+            )
+    elif info.compress_type == zipfile.ZIP_DEFLATED:
+        if info.file_size > MAX_COMPRESSION_RATIO * max(info.compress_size, 1):
+            raise FileFormatError(
+                f"{where} declares {info.file_size} bytes from {info.compress_size} "
+                f"compressed, a ratio above {MAX_COMPRESSION_RATIO} (deflate gives at most "
+                "1032): a zip bomb or a forged size; nothing was decompressed"
+            )
+    else:
+        raise FileFormatError(
+            f"{where} uses zip compression method {info.compress_type}; expected stored (0) "
+            "or deflated (8), as numpy writes"
+        )
+    if name == "meta" and info.file_size > MAX_META_BYTES:
+        raise FileFormatError(
+            f"{where}: metadata of {info.file_size} bytes, above the limit of {MAX_META_BYTES}"
+        )
+
+
+def _read_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path, name: str) -> np.ndarray:
+    """One ``.npy`` member, its header checked against the declared size before the array
+    is allocated, then read with bounded reads (and its CRC checked)."""
+    where = f"{path}: member {info.filename!r}"
+    with zf.open(info) as fh:
+        try:
+            major, minor = np.lib.format.read_magic(fh)
+            if (major, minor) == (1, 0):
+                shape, fortran, dtype = np.lib.format.read_array_header_1_0(
+                    fh, max_header_size=10000
+                )
+            elif (major, minor) == (2, 0):
+                shape, fortran, dtype = np.lib.format.read_array_header_2_0(
+                    fh, max_header_size=10000
+                )
+            else:
+                raise FileFormatError(
+                    f"{where}: .npy format version {major}.{minor}; expected 1.0 or 2.0"
+                )
+        except FileFormatError:
+            raise
+        except (ValueError, TypeError, SyntaxError, EOFError) as exc:
+            raise FileFormatError(f"{where}: not a valid .npy array header: {exc}") from None
+        if dtype.hasobject or dtype.fields is not None or dtype.subdtype is not None:
+            raise FileFormatError(f"{where}: dtype {dtype} is not a plain numeric dtype")
+        allowed = "U" if name == "meta" else "iu" if name == "rank" else "f"
+        if dtype.kind not in allowed or dtype.itemsize == 0:
+            what = {"U": "a string", "iu": "integers", "f": "real floats"}[allowed]
+            raise FileFormatError(f"{where}: dtype {dtype}; expected {what}")
+        count = 1
+        for n in shape:
+            count *= n
+        header = fh.tell()
+        needed = header + count * dtype.itemsize
+        if needed != info.file_size:
+            raise FileFormatError(
+                f"{where}: the header claims shape {shape} of {dtype} ({count * dtype.itemsize} "
+                f"bytes) but the archive declares {info.file_size - header} bytes of data; "
+                "refused before allocating"
+            )
+        array = np.empty(count, dtype=dtype)
+        raw = array.view(np.uint8).reshape(-1)
+        done = 0
+        while done < raw.size:
+            chunk = fh.read(min(raw.size - done, 1 << 24))
+            if not chunk:
+                raise FileFormatError(
+                    f"{where}: ends after {done} of {raw.size} data bytes (truncated)"
+                )
+            raw[done : done + len(chunk)] = np.frombuffer(chunk, dtype=np.uint8)
+            done += len(chunk)
+        if fh.read(1):  # also makes zipfile check the CRC
+            raise FileFormatError(f"{where}: holds more bytes than its header describes")
+    return array.reshape(shape, order="F" if fortran else "C")
+
+
+def _parse_meta(meta_array: np.ndarray, path: Path) -> dict[str, Any]:
+    if meta_array.shape != ():
+        raise FileFormatError(
+            f"{path}: member 'meta.npy' has shape {meta_array.shape}; expected one string"
+        )
+    try:
+        meta = json.loads(str(meta_array[()]))
+    except (ValueError, RecursionError) as exc:
+        raise FileFormatError(
+            f"{path}: metadata is not valid JSON: {type(exc).__name__}: {str(exc)[:200]}"
+        ) from None
+    if not isinstance(meta, dict):
+        raise FileFormatError(f"{path}: metadata is not a JSON object")
+    return meta
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _check_meta(
+    meta: dict[str, Any], path: Path
+) -> tuple[int, dict[str, Any], str, str, dict[str, Any]]:
+    """(format version, body fields, status, message, stats), each checked."""
+    version = meta.get("format_version")
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise FileFormatError(f"{path}: format_version must be a positive integer; got {version!r}")
+    if version > FORMAT_VERSION:
+        raise FileFormatError(
+            f"{path}: trajectory format version {version} was written by a newer gmuk; "
+            f"this one reads versions up to {FORMAT_VERSION}: upgrade gmuk"
+        )
+    missing = [k for k in (*_META_KEYS, "stats") if k not in meta]
+    if missing:
+        raise FileFormatError(
+            f"{path}: not a gmuk trajectory (missing metadata {', '.join(map(repr, missing))})"
+        )
+    names, kinds, dofs = meta["body_names"], meta["body_kinds"], meta["body_dofs"]
+    for key, value in (("body_names", names), ("body_kinds", kinds), ("body_dofs", dofs)):
+        if not isinstance(value, list):
+            raise FileFormatError(f"{path}: metadata {key} must be a list; got {value!r:.80}")
+    if not (len(names) == len(kinds) == len(dofs)):
+        raise FileFormatError(
+            f"{path}: metadata body_names, body_kinds and body_dofs have lengths "
+            f"{len(names)}, {len(kinds)}, {len(dofs)}; expected one entry per body"
+        )
+    if not all(isinstance(n, str) for n in names) or len(set(names)) != len(names):
+        raise FileFormatError(
+            f"{path}: metadata body_names must be distinct strings; got {names!r:.200}"
+        )
+    for name, kind, dof in zip(names, kinds, dofs, strict=True):
+        if kind not in _DOFS:
+            raise FileFormatError(
+                f"{path}: body {name!r} has kind {kind!r}; expected one of {list(_DOFS)}"
+            )
+        if not _is_int(dof) or dof != _DOFS[kind]:
+            raise FileFormatError(
+                f"{path}: body {name!r} ({kind}) has body_dofs {dof!r}; expected the integer "
+                f"{_DOFS[kind]}"
+            )
+    status, message, stats = meta["status"], meta["message"], meta["stats"]
+    if status not in STATUSES:
+        raise FileFormatError(
+            f"{path}: metadata status must be one of {list(STATUSES)}; got {status!r:.80}"
+        )
+    if not isinstance(message, str):
+        raise FileFormatError(f"{path}: metadata message must be a string; got {message!r:.80}")
+    _check_stats(stats, path)
+    body = {"body_names": tuple(names), "body_kinds": tuple(kinds), "body_dofs": tuple(dofs)}
+    return version, body, status, message, stats
+
+
+def _check_stats(stats: Any, path: Path) -> None:
+    """The recognised entries of ``stats`` have their types; other entries are kept."""
+    if not isinstance(stats, dict):
+        raise FileFormatError(f"{path}: metadata stats must be an object; got {stats!r:.80}")
+    checks: dict[str, tuple[str, Any]] = {
+        "n_rhs": ("an integer ≥ 0", lambda v: _is_int(v) and v >= 0),
+        "n_steps": ("an integer ≥ 0", lambda v: _is_int(v) and v >= 0),
+        "n_rejected": ("an integer ≥ 0", lambda v: _is_int(v) and v >= 0),
+        "method": ("a string", lambda v: isinstance(v, str)),
+        "rtol": ("a finite number ≥ 0", _non_negative_number),
+        "atol": ("a finite number ≥ 0", _non_negative_number),
+        "compiled": ("true or false", lambda v: isinstance(v, bool)),
+        "versions": ("an object", lambda v: isinstance(v, dict)),
+        "checkpoint": ("an object", lambda v: isinstance(v, dict)),
+    }
+    for key, (what, ok) in checks.items():
+        if key in stats and not ok(stats[key]):
+            raise FileFormatError(
+                f"{path}: metadata stats[{key!r}] must be {what}; got {stats[key]!r:.80}"
+            )
+
+
+def _non_negative_number(value: Any) -> bool:
+    return (
+        isinstance(value, (int, float))
+        and not isinstance(value, bool)
+        and math.isfinite(value)
+        and value >= 0
+    )
+
+
+def _check_dtypes(members: dict[str, np.ndarray], path: Path) -> dict[str, Any]:
+    """The arrays as float64 (int64 for ``rank``); exact conversions only."""
+    out: dict[str, Any] = {}
+    for name in _ARRAYS:
+        a = members[name]
+        if name == "rank":
+            if a.dtype.kind == "u" and a.size and int(a.max()) > np.iinfo(np.int64).max:
+                raise FileFormatError(f"{path}: array 'rank' holds values beyond int64")
+            out[name] = a.astype(np.int64, copy=False)
+        else:
+            out[name] = a.astype(np.float64, copy=False)  # float16/32 -> 64 is exact
+    return out
 
 
 def _check_consistent(traj: Trajectory, path: Path) -> None:
@@ -453,3 +749,65 @@ def _check_consistent(traj: Trajectory, path: Path) -> None:
         values = getattr(traj, name)
         if values.dtype.kind not in "iuf" or not np.isfinite(values).all():
             raise FileFormatError(f"{path}: array {name!r} holds non-finite or non-real values")
+
+
+def _check_values(traj: Trajectory, path: Path) -> None:
+    """Times increase, poses are on SE(3), residuals and ranks are in their ranges."""
+    steps = np.diff(traj.t)
+    if (steps <= 0).any():
+        i = int(np.argmax(steps <= 0))
+        raise FileFormatError(
+            f"{path}: times t must strictly increase; t[{i + 1}] = {float(traj.t[i + 1])!r} "
+            f"follows t[{i}] = {float(traj.t[i])!r}"
+        )
+    g = traj.g_NB
+    if g.size:
+        rigid = [n for n, k in zip(traj.body_names, traj.body_kinds, strict=True) if k == "rigid"]
+        row = np.abs(g[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(axis=-1)
+        R = g[..., :3, :3]
+        ortho = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-1, -2))
+        det = np.linalg.det(R)
+        for label, bad in (
+            ("bottom row is not [0, 0, 0, 1]", row > POSE_TOL),
+            ("rotation block is not orthonormal (RᵀR ≠ I)", ortho > POSE_TOL),
+            (
+                "rotation block is a reflection or not a rotation (det R ≠ 1)",
+                np.abs(det - 1.0) > POSE_TOL,
+            ),
+        ):
+            if bad.any():
+                i, k = (int(v) for v in np.argwhere(bad)[0])
+                raise FileFormatError(
+                    f"{path}: array 'g_NB': the pose of body "
+                    f"{rigid[k]!r} at output {i} (t = {float(traj.t[i])!r} s): "
+                    f"{label} (‖RᵀR − I‖ = {ortho[i, k]:.3g}, det R = {det[i, k]:.6g}, bottom "
+                    f"row off by {row[i, k]:.3g}; tolerance {POSE_TOL})"
+                )
+    if (traj.residual < 0).any():
+        raise FileFormatError(f"{path}: array 'residual' holds negative norms")
+    n_dof = traj.layout.n_dof
+    if traj.rank.size and not (-1 <= traj.rank.min() and traj.rank.max() <= n_dof):
+        raise FileFormatError(
+            f"{path}: array 'rank' holds values outside [-1, {n_dof}] (-1: not computed)"
+        )
+
+
+def _check_copies(
+    traj: Trajectory, copies: dict[str, np.ndarray], version: int, path: Path
+) -> None:
+    """``r_N`` and ``v_N`` are present from version 2 on and equal to the point masses'
+    columns of ``x`` and ``xdot``."""
+    if version >= 2 and len(copies) != 2:
+        raise FileFormatError(
+            f"{path}: format version {version} files hold 'r_N' and 'v_N'; "
+            f"{'only one is' if copies else 'neither is'} present"
+        )
+    for name, expected in (("r_N", traj.r_N), ("v_N", traj.v_N)):
+        if name not in copies:
+            continue
+        got = copies[name]
+        if got.shape != expected.shape or not np.array_equal(got, expected):
+            raise FileFormatError(
+                f"{path}: array {name!r} (shape {got.shape}) is not the point masses' "
+                f"columns of {'x' if name == 'r_N' else 'xdot'} (shape {expected.shape})"
+            )
