@@ -81,7 +81,10 @@ def load_gfc(path: str | os.PathLike[str], *, degree: int | None = None) -> Sphe
     FileFormatError
         Malformed file: missing ``end_of_head`` or a required header key, a number that does
         not parse, NaN or infinity, a wrong number of columns, a degree or order out of
-        range, a duplicate or missing coefficient, a truncated file.
+        range, a duplicate or missing coefficient, a truncated file. Non-physical header
+        values are refused too: GM or radius ≤ 0, a negative ``max_degree``. A
+        ``max_degree`` whose arrays would exceed :data:`MAX_ARRAY_BYTES`, or that the file's
+        lines cannot fill, is refused before anything is allocated for it.
     DegreeError
         ``degree`` above the file's ``max_degree``.
     FileNotFoundError
@@ -253,6 +256,11 @@ def load_shadr(
         Malformed file: a header record without its eight fields, an unknown normalisation
         state, a number that does not parse, NaN or infinity, a wrong number of columns, a
         degree or order out of range, a duplicate or missing coefficient, a truncated file.
+        Non-physical header values are refused too: R_ref or GM ≤ 0, a negative sigma GM,
+        a reference latitude outside [−90°, 90°] or longitude outside [−180°, 360°], a
+        negative degree or an order outside [0, degree]. A header degree whose arrays would
+        exceed :data:`MAX_ARRAY_BYTES`, or that the file's lines cannot fill, is refused
+        before anything is allocated for it.
     DegreeError
         ``degree`` above the file's degree.
     """
@@ -283,6 +291,21 @@ def load_shadr(
         raise FileFormatError(
             f"{p}: line {no}: R_ref and GM must be > 0; got R_ref = {r_km!r} km, "
             f"GM = {gm_km!r} km³/s²"
+        )
+    if not sig_gm >= 0:
+        raise FileFormatError(
+            f"{p}: line {no}: sigma GM (field 3) must be >= 0 (a standard deviation); got "
+            f"{sig_gm!r} km³/s²"
+        )
+    if not -90.0 <= ref_lat <= 90.0:
+        raise FileFormatError(
+            f"{p}: line {no}: reference latitude (field 8) must be within [-90, 90] deg; got "
+            f"{ref_lat!r}"
+        )
+    if not -180.0 <= ref_lon <= 360.0:
+        raise FileFormatError(
+            f"{p}: line {no}: reference longitude (field 7) must be within [-180, 360] deg "
+            f"(east, either convention); got {ref_lon!r}"
         )
     if nmax < 0 or not 0 <= mmax <= nmax:
         raise FileFormatError(
@@ -422,13 +445,19 @@ def _file(path: Any, who: str) -> Path:
 #: Up to this many bytes of coefficient arrays are allocated before the lines are read (a
 #: truncated file then gets the reader's precise message naming the first missing term).
 _SMALL_ALLOCATION = 64 * 2**20
+#: Most bytes of coefficient arrays a reader allocates (5 arrays of (n + 1)² 8-byte numbers
+#: for degree n: 4 GiB is degree 10 360, above every published gravity field's 2190 to
+#: 5540). A header claiming more is refused before any allocation, whatever the file holds.
+MAX_ARRAY_BYTES = 4 * 2**30
 
 
 def _check_size(path: Path, no: int, key: str, nmax: int, mmax: int, lines: int) -> None:
-    """Refuse a header degree the file's own lines cannot fill, before allocating for it
-    (5 arrays of (nmax + 1)² floats): a complete field of degree nmax (order ≤ mmax) has one
-    line per coefficient of degrees 2..nmax (degrees 0 and 1 may be left out)."""
-    if 5 * 8 * (nmax + 1) ** 2 <= _SMALL_ALLOCATION:
+    """Refuse a header degree whose arrays would exceed :data:`MAX_ARRAY_BYTES`, or that
+    the file's own lines cannot fill, before allocating for it (5 arrays of (nmax + 1)²
+    floats): a complete field of degree nmax (order ≤ mmax) has one line per coefficient of
+    degrees 2..nmax (degrees 0 and 1 may be left out)."""
+    size = 5 * 8 * (nmax + 1) ** 2
+    if size <= _SMALL_ALLOCATION:
         return
     full = min(nmax, mmax)
     # Σ_{n=2}^{nmax} (min(n, mmax) + 1), in closed form (a hostile header may say 1e18)
@@ -436,10 +465,24 @@ def _check_size(path: Path, no: int, key: str, nmax: int, mmax: int, lines: int)
     needed = up_to_full + max(0, nmax - max(full, 1)) * (mmax + 1)
     if lines < needed:
         raise FileFormatError(
-            f"{path}: line {no}: the header's {key} {nmax} needs at least {needed} coefficient "
-            f"lines (degrees 2..{nmax}); the file has {lines}: a wrong header or a truncated "
-            "file"
+            f"{path}: line {no}: the header's {key} {_short(nmax)} needs at least "
+            f"{_short(needed)} coefficient lines (degrees 2..{_short(nmax)}); the file has "
+            f"{lines}: a wrong header or a truncated file"
         )
+    if size > MAX_ARRAY_BYTES:  # e.g. a zonal field (order 0): few lines, (n + 1)² floats
+        raise FileFormatError(
+            f"{path}: line {no}: the header's {key} {_short(nmax)} needs {_short(size)} bytes "
+            f"of coefficient arrays, above the limit of {MAX_ARRAY_BYTES} bytes "
+            "(gmuk.gravity.io.MAX_ARRAY_BYTES); refused before allocating"
+        )
+
+
+def _short(value: int) -> str:
+    """An integer for a message: as is below 10¹², else its order of magnitude (a hostile
+    header's degree squared may have more digits than Python prints)."""
+    if value < 10**12:
+        return str(value)
+    return f"about 1e{math.floor(math.log10(value))}"
 
 
 def _read_lines(path: Path) -> list[tuple[int, str]]:
