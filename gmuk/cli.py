@@ -27,6 +27,10 @@ the run with the options it was started with. A run that completes removes its c
 
 ``gmuk view`` writes an interactive 3-D view of a run (:mod:`gmuk.view`): one HTML file that
 opens offline in a browser. ``gmuk run`` writes it as ``DIR/view.html`` unless ``--no-plots``.
+``--out`` names the HTML file; given an existing folder, ``gmuk view`` writes ``view.html``
+into it (as ``cp FILE DIR`` does). The trajectory file is checked as
+:func:`gmuk.load_trajectory` checks it; a file it refuses, or an output it cannot write,
+stops with a message and exit status 2.
 
 ``gmuk check`` prints the table of :func:`gmuk.check <gmuk.crosscheck.check>` and exits 0 if
 every quantity agrees with Pinocchio within its tolerance, 1 if any does not.
@@ -343,7 +347,8 @@ def _add_view_parser(sub: Any) -> None:
         type=Path,
         default=None,
         metavar="FILE.html",
-        help="output file (default: RUN_DIR/view.html, or FILE.html beside FILE.npz)",
+        help="output file, or an existing folder to write view.html into (default: "
+        "RUN_DIR/view.html, or FILE.html beside FILE.npz)",
     )
     view.add_argument(
         "--central-radius",
@@ -388,19 +393,35 @@ def _view(args: argparse.Namespace) -> int:
     if path.is_dir() and summary.is_file():
         try:
             name = json.loads(summary.read_text()).get("scenario")
-        except (OSError, ValueError, AttributeError):
+        except (OSError, ValueError, AttributeError, RecursionError):
             name = None
+        if not isinstance(name, str):
+            name = None  # a hand-edited summary: no scenario, no sphere
     radius = args.central_radius
     if radius is None and name is not None:
         radius = _scenario_radius(name)
-    out = args.out or (path / "view.html" if path.is_dir() else npz.with_suffix(".html"))
-    written = write_view(
-        load_trajectory(npz),
-        out,
-        central_radius=radius,
-        title=f"gmuk: {name}" if name else f"gmuk: {npz.name}",
-        max_frames=args.max_frames,
-    )
+    out: Path = args.out or (path / "view.html" if path.is_dir() else npz.with_suffix(".html"))
+    if out.is_dir():  # like cp FILE DIR: the view goes inside the folder
+        out = out / "view.html"
+        if out.is_dir():
+            raise OptionError(
+                f"gmuk view: --out {str(args.out)!r} is a folder holding a folder named "
+                "view.html; give the .html file to write"
+            )
+    traj = load_trajectory(npz)
+    try:
+        written = write_view(
+            traj,
+            out,
+            central_radius=radius,
+            title=f"gmuk: {name}" if name else f"gmuk: {npz.name}",
+            max_frames=args.max_frames,
+        )
+    except OSError as exc:
+        raise OptionError(
+            f"gmuk view: cannot write {str(out)!r}: {exc.strerror or exc} (--out takes an "
+            "HTML file name or an existing folder)"
+        ) from None
     print(f"wrote {written} (open it in a browser; it needs no network)")
     return 0
 

@@ -337,8 +337,22 @@ def write_view(
     title : str
     **options
         ``triad_length`` (m), ``max_frames``, ``max_path_points``, as :func:`view_html`.
+
+    Raises
+    ------
+    DefinitionError
+        ``path`` is an existing folder (``gmuk view --out DIR`` writes ``DIR/view.html``;
+        this function writes exactly the file it is given), or as :func:`view_html`.
+    OSError
+        The file or its folder cannot be written (permissions, a file where a folder
+        should be); ``gmuk view`` reports it as a message with exit status 2.
     """
     path = Path(path)
+    if path.is_dir():
+        raise DefinitionError(
+            f"write_view: {str(path)!r} is a folder; give the .html file to write "
+            f"(e.g. {str(path / 'view.html')!r})"
+        )
     path.parent.mkdir(parents=True, exist_ok=True)
     return write_text_atomic(
         path, view_html(traj, central_radius=central_radius, title=title, **options)
