@@ -25,6 +25,13 @@ into ``DIR/.checkpoints`` every ``--checkpoint-every`` seconds (default 60), so 
 process (SIGKILL, a power cut) loses at most one interval; ``gmuk run --resume DIR`` continues
 the run with the options it was started with. A run that completes removes its checkpoints.
 
+One run at a time owns an output folder: ``gmuk run`` (and ``--resume``) holds a lock on
+``DIR/.gmuk.lock`` (:mod:`gmuk._locks`; the file names the process, host and start time) for
+as long as it runs. A second run into the same folder is refused at once with a
+:class:`~gmuk._locks.FolderInUseError` naming the first (exit status 2) and changes nothing
+there. The kernel releases the lock when its process ends, however it ends: a killed run never
+blocks the next one.
+
 ``gmuk view`` writes an interactive 3-D view of a run (:mod:`gmuk.view`): one HTML file that
 opens offline in a browser. ``gmuk run`` writes it as ``DIR/view.html`` unless ``--no-plots``.
 ``--out`` names the HTML file; given an existing folder, ``gmuk view`` writes ``view.html``
@@ -46,14 +53,15 @@ import sys
 import threading
 import time
 from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from types import FrameType
 from typing import Any, NoReturn
 
 from gmuk import runs, scenarios
-from gmuk.errors import GmukError
+from gmuk._locks import folder_lock
 from gmuk.engine.integrate import versions
+from gmuk.errors import GmukError
 from gmuk.runs import RunControl
 from gmuk.scenarios import OptionError, Scenario
 from gmuk.trajectory import write_text_atomic
@@ -247,15 +255,46 @@ def _run(argv: Sequence[str]) -> int:
         for key, value in vars(args).items()
         if key.startswith("option:") and value is not None
     }
-    if args.resume is not None:
-        scenario, options, out = _resumed(args, scenario, name_given, given)
-    else:
-        options = scenario.parse_options(given)
-        out = args.out or Path("gmuk-out") / scenario.name
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OptionError(f"--out {str(out)!r}: cannot make the output folder: {exc}") from None
+    with ExitStack() as owned:
+        # One run at a time in a folder (gmuk._locks): a second one is refused before it
+        # touches anything, and the lock dies with its process.
+        if args.resume is not None:
+            if args.resume.is_dir():
+                owned.enter_context(
+                    folder_lock(
+                        args.resume,
+                        "gmuk run --resume",
+                        hint="a run is being written or resumed there; wait for it to end",
+                    )
+                )
+            scenario, options, out = _resumed(args, scenario, name_given, given)
+        else:
+            options = scenario.parse_options(given)
+            out = args.out or Path("gmuk-out") / scenario.name
+            try:
+                out.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise OptionError(
+                    f"--out {str(out)!r}: cannot make the output folder: {exc}"
+                ) from None
+            owned.enter_context(
+                folder_lock(
+                    out,
+                    f"gmuk run {scenario.name}",
+                    hint="wait for that run to end, or give another --out",
+                )
+            )
+        return _run_owned(args, scenario, options, out, formats)
+
+
+def _run_owned(
+    args: argparse.Namespace,
+    scenario: Scenario,
+    options: dict[str, Any],
+    out: Path,
+    formats: tuple[str, ...],
+) -> int:
+    """``gmuk run``'s work in ``out``, whose lock the caller holds."""
     folder = out / CHECKPOINTS
     every = args.checkpoint_every if args.checkpoint_every > 0 else float("inf")
     if args.resume is None:
