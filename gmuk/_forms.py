@@ -35,9 +35,10 @@ class Forms:
     Parameters
     ----------
     compiled : True or str
-        A compiled form the step loop calls: a force model's ``_compiled_term`` (its kernel,
-        ``_kernel``, called through :func:`gmuk.forces._kernels.apply_term`), a controller's
-        ``_compiled_term`` (:func:`gmuk.control._kernels.apply_control`).
+        A compiled form the step loop calls through its address: the kernel of a part's
+        ``_compiled_term`` (a force model's or constraint's ``_kernel``, with the signature
+        :data:`~gmuk.forces.base.FORCE_KERNEL` or :data:`~gmuk.constraints.base.ROWS_KERNEL`;
+        a controller's, :data:`~gmuk.control.base.CONTROL_KERNEL`).
     symbolic : True or str
         A CasADi form for :mod:`gmuk.optimize` (``casadi_force``, ``casadi_wrench``,
         ``casadi_wrenches``, ``casadi_value``, ``casadi_residual``; see

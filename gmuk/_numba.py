@@ -42,6 +42,18 @@ digest differs (a kernel edited anywhere, in a development install), the folder'
 indexes are removed before anything is loaded from it (:func:`check_cache_folder`), and the
 kernels compile again and write new ones.
 
+Kernels called through their address
+-------------------------------------
+The compiled step loop does not contain the parts' kernels: it calls each through the address
+of its compiled function (:func:`kernel_address`), with :func:`kernel_caller`, in numba's own
+calling convention, so that an exception a kernel raises reaches the caller as it would from
+a direct call. A kernel is then compiled (or loaded from the cache) only when a System uses
+it, and neither the loop's compiled code nor its compile time grows with the number of parts
+gmuk or a plugin defines. Each kind of part fixes its kernels' signature (the argument types
+the loop passes, :data:`gmuk.forces.base.FORCE_KERNEL` and its kin); the caller checks the
+argument types against it when the loop compiles, and :func:`kernel_address` compiles the
+kernel for exactly that signature.
+
 Calling without the dispatcher
 ------------------------------
 numba's dispatcher resolves the types of a kernel's arguments on every call, which costs
@@ -67,20 +79,35 @@ from pathlib import Path
 from typing import Any
 
 import numba
+from numba import types
+from numba.core import cgutils
 from numba.core.caching import FunctionCache
+from numba.core.errors import TypingError
+from numba.extending import intrinsic
 
 from gmuk.errors import GmukWarning
 
 __all__ = [
+    "C1",
+    "C1_READONLY",
+    "C2",
     "LazyEntries",
     "cache_plan",
     "check_cache_folder",
     "compiled_entry",
     "entry",
+    "kernel_address",
+    "kernel_caller",
     "njit",
     "sources_key",
     "user_cache_dir",
 ]
+
+#: The array types of the parts' kernel signatures: C-contiguous float64, 1-D, 2-D and
+#: read-only 1-D (a spherical-harmonic field's data, shared by every term of a program).
+C1 = types.Array(types.float64, 1, "C")
+C2 = types.Array(types.float64, 2, "C")
+C1_READONLY = types.Array(types.float64, 1, "C", readonly=True)
 
 #: numba's configuration module (its settings are attributes made at run time).
 _config: Any = numba.config
@@ -340,3 +367,78 @@ class LazyEntries:
         fn = compiled_entry(kernel, signature)
         setattr(self, name, fn)
         return fn
+
+
+def kernel_address(kernel: Any, signature: Any) -> int:
+    """The address of ``kernel``'s compiled function for ``signature``, compiled now or loaded
+    from numba's cache: what :func:`kernel_caller`'s intrinsic calls.
+
+    Parameters
+    ----------
+    kernel : numba dispatcher
+        A kernel made with :func:`njit` without a signature.
+    signature : numba signature
+        The signature of the kind of part (return type included).
+
+    Raises
+    ------
+    DefinitionError
+        When the kernel does not compile for ``signature`` or returns another type.
+    """
+    from gmuk.errors import DefinitionError
+
+    name = getattr(kernel, "__qualname__", repr(kernel))
+    try:
+        if signature.args not in kernel.overloads:
+            kernel.compile(signature)
+        cres = kernel.overloads[signature.args]
+    except Exception as exc:  # numba's typing and lowering errors
+        raise DefinitionError(
+            f"kernel {name} does not compile for the signature {signature}: {exc}"
+        ) from exc
+    if types.unliteral(cres.signature.return_type) != signature.return_type:
+        raise DefinitionError(
+            f"kernel {name} returns {cres.signature.return_type}; its kind of part asks for "
+            f"{signature.return_type}"
+        )
+    return int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+
+
+def kernel_caller(signature: Any, kind: str) -> Any:
+    """An intrinsic ``call(address, args)`` that calls the kernel at ``address`` (from
+    :func:`kernel_address` with the same ``signature``) with the tuple ``args`` and returns
+    its result; an exception the kernel raises propagates to the caller.
+
+    The argument types must be exactly ``signature.args``: the caller's compilation fails
+    otherwise (a kernel given other types would read its arguments wrongly). ``kind`` names
+    the kind of part in that error.
+    """
+    expected = tuple(signature.args)
+
+    def call(typingctx, address, args):  # type: ignore[no-untyped-def]
+        if not isinstance(address, types.Integer) or not isinstance(args, types.BaseTuple):
+            return None
+        if tuple(args.types) != expected:
+            raise TypingError(
+                f"a {kind} kernel takes {expected}; the caller passes {tuple(args.types)}"
+            )
+
+        def codegen(context, builder, sig, llargs):  # type: ignore[no-untyped-def]
+            conv = context.call_conv
+            fnty = conv.get_function_type(signature.return_type, expected)
+            fn = builder.inttoptr(llargs[0], fnty.as_pointer())
+            ret = cgutils.alloca_once(builder, fnty.args[0].pointee)
+            builder.store(cgutils.get_null_value(fnty.args[0].pointee), ret)
+            excinfo = cgutils.alloca_once(builder, fnty.args[1].pointee, name="excinfo")
+            values = [builder.extract_value(llargs[1], i) for i in range(len(expected))]
+            packed = list(conv._get_arg_packer(expected).as_arguments(builder, values))
+            code = builder.call(fn, [ret, excinfo, *packed])
+            status = conv._get_return_status(builder, code, builder.load(excinfo))
+            with cgutils.if_unlikely(builder, status.is_error):
+                conv.return_status_propagate(builder, status)
+            return builder.load(ret)
+
+        return signature.return_type(address, args), codegen
+
+    call.__name__ = call.__qualname__ = f"call_{kind.replace(' ', '_')}_kernel"
+    return intrinsic(call)

@@ -1054,3 +1054,76 @@ def test_a_cache_folder_written_under_other_kernel_sources_is_emptied_once(tmp_p
     # every source that defines a kernel is in the digest
     sources = {p.name for p in _numba._kernel_sources()}
     assert {"_compiled.py", "_kernels.py", "gravity.py", "_uk_kernels.py"} <= sources
+
+
+@numba.njit
+def _quadratic_drag_load(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
+    """f_N = −c |v_N| v_N at the centre of mass, p = (c,): a kernel that gmuk does not know."""
+    if rigid:
+        vx = g[0, 0] * V[3] + g[0, 1] * V[4] + g[0, 2] * V[5]
+        vy = g[1, 0] * V[3] + g[1, 1] * V[4] + g[1, 2] * V[5]
+        vz = g[2, 0] * V[3] + g[2, 1] * V[4] + g[2, 2] * V[5]
+    else:
+        vx, vy, vz = V[0], V[1], V[2]
+    k = -p[0] * np.sqrt(vx * vx + vy * vy + vz * vz)
+    gmuk.forces.base.com_load(rigid, g, k * vx, k * vy, k * vz, out)
+    return 0
+
+
+class _QuadraticDrag(gmuk.ForceModel):
+    """A model defined outside gmuk with a compiled form: nothing registers its kernel."""
+
+    _kernel = staticmethod(_quadratic_drag_load)
+    _forms = gmuk._forms.Forms(compiled=True, symbolic="a test model")
+
+    def __init__(self, c):
+        super().__init__()
+        self.c = c
+
+    def _kernel_params(self, body):
+        return (self.c,), None
+
+    def force(self, t, r_N, v_N, body):
+        return self._kernel_load(False, t, r_N, v_N, body)
+
+    def wrench(self, t, g_NB, V_B, body):
+        return self._kernel_load(True, t, g_NB, V_B, body)
+
+
+def test_a_force_model_defined_outside_gmuk_runs_compiled_without_registration():
+    sc = gmuk.RigidBody("sc", 50.0, np.diag([2.0, 3.0, 4.0]))
+    p = gmuk.PointMass("p", 2.0)
+    system = gmuk.System([sc, p], forces=[_QuadraticDrag(0.3)])
+    state = system.state(
+        g={"sc": np.eye(4)},
+        V={"sc": [0.1, -0.2, 0.3, 3.0, -1.0, 2.0]},
+        r={"p": [0.0, 0.0, 0.0]},
+        v={"p": [1.0, -2.0, 0.5]},
+    )
+    prog = system.compiled_program(get_method("DOP853"), state)
+    assert not prog.parts.dims.python_parts and prog.parts.terms.shape[0] == 2  # both compiled
+    _assert_same_right_hand_sides(system, state, prog)
+    kw = {"t_eval": np.linspace(0.0, 5.0, 6), "rtol": 1e-11, "atol": 1e-12}
+    fast = system.simulate(state, (0.0, 5.0), **kw)
+    slow = reference_simulate(system, state, (0.0, 5.0), **kw)
+    np.testing.assert_allclose(fast.x, slow.x, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(fast.V_B, slow.V_B, rtol=0, atol=1e-9)
+    # |v| of the point mass: dv/dt = −(c/m)|v|², so |v(t)| = |v0| / (1 + c|v0| t/m)
+    v0 = np.linalg.norm([1.0, -2.0, 0.5])
+    speed = np.linalg.norm(fast.xdot[:, :3], axis=1)
+    np.testing.assert_allclose(speed, v0 / (1 + 0.3 * v0 * fast.t / 2.0), rtol=1e-9)
+
+
+def test_a_kernel_that_does_not_fit_its_kind_of_part_is_refused_when_the_program_is_built():
+    @numba.njit
+    def returns_a_float(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
+        out[:] = 0.0
+        return 0.0  # a status must be an integer: the loop would read these bits as one
+
+    class Wrong(_QuadraticDrag):
+        _kernel = staticmethod(returns_a_float)
+
+    system = gmuk.System([gmuk.PointMass("p", 1.0)], forces=[Wrong(0.1)])
+    state = system.state(r={"p": [0.0, 0.0, 0.0]}, v={"p": [1.0, 0.0, 0.0]})
+    with pytest.raises(DefinitionError, match="returns float64"):
+        system.compiled_program(get_method("DOP853"), state)

@@ -6,11 +6,10 @@ in its own body (``_forms = Forms(compiled=..., symbolic=...)``: True, or the re
 none) and have a factory of random valid instances here. Then, at 100 random states each:
 
 * its Python form (``wrenches``, ``control``, ``rows``/``value``) runs and is finite;
-* a declared compiled form exists for the case and gives the Python numbers: force models
-  through ``gmuk.forces._kernels.apply_term`` with the code and parameters of
-  ``_compiled_term`` (arguments laid out as the compiled loop lays them out), controllers
-  through ``gmuk.control._kernels.apply_control``, constraints' rows through
-  ``gmuk.constraints._kernels.apply_rows``;
+* a declared compiled form exists for the case and gives the Python numbers: the kernel of
+  ``_compiled_term`` is called through its address with the compiled loop's own callers
+  (``_call_force``, ``_call_control``, ``_call_rows``) and the parameters of
+  ``_compiled_term``, arguments laid out as the compiled loop lays them out;
 * a declared symbolic form exists and gives the Python numbers when evaluated on numbers
   (CasADi ``DM``): force models through ``gmuk.optimize.parts.force_terms``, inequalities
   through ``parts.inequality_value``;
@@ -40,6 +39,7 @@ from functools import cache
 from typing import Any
 
 import casadi as ca
+import numba
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -47,13 +47,12 @@ from hypothesis import strategies as st
 
 import gmuk
 from gmuk._forms import FORMS, Forms
-from gmuk.constraints._kernels import apply_rows
-from gmuk.constraints.base import Constraint
-from gmuk.control._kernels import apply_control
-from gmuk.control.base import Controller
+from gmuk._numba import kernel_address
+from gmuk.constraints.base import ROWS_KERNEL, Constraint
+from gmuk.control.base import CONTROL_KERNEL, Controller
+from gmuk.engine.integrators._compiled import _call_control, _call_force, _call_rows
 from gmuk.errors import DefinitionError
-from gmuk.forces import _kernels as force_kernels
-from gmuk.forces.base import ForceModel
+from gmuk.forces.base import FORCE_KERNEL, ForceModel
 from gmuk.lie import se3, so3
 from gmuk.optimize import parts
 from gmuk.orbits import KeplerOrbit, LVLHReference
@@ -465,9 +464,24 @@ def _model_bodies(case: Case) -> list[Any]:
 _NO_INERTIA = np.zeros((3, 3))
 
 
-def _apply_term(term: tuple[int, Any, Any], body: Any, state: gmuk.State) -> np.ndarray:
-    """``apply_term`` with its arguments laid out as the compiled loop lays them out."""
-    code, values, data = term
+@numba.njit
+def _force_at(address, rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
+    return _call_force(address, (rigid, t, g, V, m, J, p, field, out))
+
+
+@numba.njit
+def _control_at(address, t, g, V, a_model, z, p, u, z_dot):  # type: ignore[no-untyped-def]
+    return _call_control(address, (t, g, V, a_model, z, p, u, z_dot))
+
+
+@numba.njit
+def _rows_at(address, t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
+    return _call_rows(address, (t, g1, V1, g2, V2, p, A, b))
+
+
+def _apply_term(term: tuple[Any, Any, Any], body: Any, state: gmuk.State) -> np.ndarray:
+    """A force kernel called through its address as the compiled loop calls it."""
+    kernel, values, data = term
     params = np.array([*values, 0.0])
     field = np.zeros(1) if data is None else np.asarray(data, dtype=float)
     field.setflags(write=False)
@@ -478,10 +492,9 @@ def _apply_term(term: tuple[int, Any, Any], body: Any, state: gmuk.State) -> np.
         g, V = np.zeros((4, 4)), np.zeros(6)
         g[:3, 3], V[:3] = state.position(body), state.velocity(body)
         m, J, out = float(body.mass), _NO_INERTIA, np.empty(3)
-    status = force_kernels.apply_term(
-        code, body.kind == "rigid", state.t, g, V, m, J, params, field, out
-    )
-    assert status == 0, f"apply_term returned status {status}"
+    address = kernel_address(kernel, FORCE_KERNEL)
+    status = _force_at(address, body.kind == "rigid", state.t, g, V, m, J, params, field, out)
+    assert status == 0, f"the force kernel returned status {status}"
     return out
 
 
@@ -528,12 +541,12 @@ def check_controller(case: Case, forms: Forms) -> None:
         assert term is not None, "declared compiled, but no term here"
         (body,) = ctl.bodies
         slot = state.layout.slot(body)
-        code, params = term
+        kernel, params = term
         a_model = np.array(modeled[slot.offset : slot.offset + 6])
         out, zd = np.empty(6), np.empty(6)
-        status = apply_control(
-            code, state.t, np.array(state.pose(body)), np.array(state.twist(body)), a_model,
-            z, np.asarray(params, dtype=float), out, zd,
+        status = _control_at(
+            kernel_address(kernel, CONTROL_KERNEL), state.t, np.array(state.pose(body)),
+            np.array(state.twist(body)), a_model, z, np.asarray(params, dtype=float), out, zd,
         )  # fmt: skip
         assert status == 0
         _blocks_close(out, u[0], PYTHON_COMPILED_RTOL, "compiled u")
@@ -554,11 +567,13 @@ def check_constraint(case: Case, forms: Forms) -> None:
     term = c._compiled_term()
     if forms.has("compiled"):
         assert term is not None, "declared compiled, but no term here"
-        code, params, n_rows = term
+        kernel, params, n_rows = term
         ends = [(np.array(state.pose(x)), np.array(state.twist(x))) for x in bodies]
         (g1, V1), (g2, V2) = ends[0], ends[-1]
         Ak, bk = np.empty((n_rows, 12)), np.empty(n_rows)
-        status = apply_rows(code, state.t, g1, V1, g2, V2, np.asarray(params, dtype=float), Ak, bk)
+        p = np.asarray(params, dtype=float)
+        address = kernel_address(kernel, ROWS_KERNEL)
+        status = _rows_at(address, state.t, g1, V1, g2, V2, p, Ak, bk)
         assert status == 0
         _blocks_close(Ak[:, : 6 * len(bodies)].ravel(), A.ravel(), PYTHON_COMPILED_RTOL, "A")
         _blocks_close(bk, b, PYTHON_COMPILED_RTOL, "compiled b")
@@ -654,15 +669,18 @@ def test_forms_are_true_or_a_reason():
     assert FORMS == ("compiled", "symbolic")
 
 
-def test_every_compiled_force_kernel_has_one_code_and_one_class():
-    codes = force_kernels.CODES
-    assert len(set(codes.values())) == len(codes)
-    owners = {k: [c for c in CHECKED if "_kernel" in vars(c) and c._kernel is k] for k in codes}
-    assert all(len(v) == 1 for v in owners.values()), owners
-    for c in CHECKED:
-        if issubclass(c, ForceModel) and "_kernel" in vars(c):
-            assert vars(c)["_forms"].has("compiled"), c
-            assert c._kernel in codes, f"{c.__name__}._kernel has no code"
+_KERNEL_SIGNATURES = {ForceModel: FORCE_KERNEL, Constraint: ROWS_KERNEL}
+
+
+def test_every_declared_kernel_compiles_for_its_kind_of_part():
+    """A class that names a ``_kernel`` declares a compiled form, and its kernel compiles for
+    the signature the loop calls its kind with (nothing else lists it)."""
+    declared = [c for c in CHECKED if "_kernel" in vars(c)]
+    assert declared
+    for c in declared:
+        assert vars(c)["_forms"].has("compiled"), c
+        (signature,) = [s for base, s in _KERNEL_SIGNATURES.items() if issubclass(c, base)]
+        assert kernel_address(c._kernel, signature) > 0, c
 
 
 @pytest.mark.parametrize("cls", CHECKED, ids=lambda c: c.__name__)

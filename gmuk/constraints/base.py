@@ -15,9 +15,11 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 import scipy.sparse as sp
+from numba import types as numba_types
 
 from gmuk._forms import DeclaresForms
 from gmuk._frozen import FreezesInSystem
+from gmuk._numba import C1, C2
 from gmuk._validation import FloatArray, distinct_bodies
 from gmuk.bodies import BodyKind
 from gmuk.errors import ConstraintError, DefinitionError
@@ -26,7 +28,13 @@ if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
 
-__all__ = ["Baumgarte", "Constraint"]
+__all__ = ["ROWS_KERNEL", "Baumgarte", "Constraint"]
+
+#: The signature of a constraint's rows kernel, as the compiled loop calls it:
+#: ``(t, g_1 (4, 4), V_1 (6,), g_2, V_2, p, A (s, 12), b (s,)) -> status``, writing the rows
+#: of the constraint on its first body (columns 0–5) and its second one (columns 6–11; zero,
+#: and ``g_2, V_2`` ignored, for a one-body constraint); status 0 or a failure code.
+ROWS_KERNEL = numba_types.int64(numba_types.float64, C2, C1, C2, C1, C1, C2, C1)
 
 
 @dataclass(frozen=True)
@@ -117,23 +125,18 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
         object.__setattr__(self, "_bodies", bodies)
         object.__setattr__(self, "_name", name or type(self).__name__)
 
-    def _compiled_term(self) -> tuple[int, tuple[float, ...], int] | None:
-        """How the compiled step loop computes this constraint's rows: (code of its kernel in
-        :mod:`gmuk.constraints._kernels`, parameters, number of rows), or None when its rows
+    def _compiled_term(self) -> tuple[Any, tuple[float, ...], int] | None:
+        """How the compiled step loop computes this constraint's rows: (its kernel, with the
+        signature :data:`ROWS_KERNEL`; parameters; number of rows), or None when its rows
         come from Python. A constraint has the compiled form of the class that defines its
         ``_kernel`` when its ``rows`` is that class's (a subclass that overrides ``rows`` has
         none), and when ``_kernel_params()`` packs parameters for it."""
         kernel = self._declared_form("_kernel")
-        if kernel is None:
-            return None
-        from gmuk.constraints._kernels import CODES
-
-        code = CODES.get(kernel)
-        packed = self._kernel_params() if code is not None else None
-        if code is None or packed is None:
+        packed = self._kernel_params() if kernel is not None else None
+        if packed is None:
             return None
         params, n_rows = packed
-        return code, tuple(float(v) for v in params), int(n_rows)
+        return kernel, tuple(float(v) for v in params), int(n_rows)
 
     def _kernel_params(self) -> tuple[Any, int] | None:
         """The parameters of ``_kernel`` and the number of rows; None when the kernel cannot

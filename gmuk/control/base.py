@@ -17,9 +17,11 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
+from numba import types as numba_types
 
 from gmuk._forms import DeclaresForms
 from gmuk._frozen import FreezesInSystem
+from gmuk._numba import C1, C2
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError
@@ -28,7 +30,13 @@ if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
 
-__all__ = ["Controller"]
+__all__ = ["CONTROL_KERNEL", "Controller"]
+
+#: The signature of a controller's kernel, as the compiled loop calls it on one rigid body:
+#: ``(t, g (4, 4), V (6,), a_model (6,), z, p, u (6,), z_dot) -> status``: the modeled
+#: acceleration ν̇_a + ν̇_c and the internal state z in, the wrench u = [u_L; u_f] (body frame,
+#: N·m, N) and the state rate ż out; status 0 or a failure code.
+CONTROL_KERNEL = numba_types.int64(numba_types.float64, C2, C1, C1, C1, C1, C1, C1)
 
 
 class Controller(FreezesInSystem, DeclaresForms, abc.ABC):
@@ -73,9 +81,10 @@ class Controller(FreezesInSystem, DeclaresForms, abc.ABC):
         """Label of the controller."""
         return self._name
 
-    def _compiled_term(self) -> tuple[int, FloatArray] | None:
-        """How the compiled step loop evaluates this controller (gmuk.control._kernels: a
-        code and packed parameters), or None when it is called in Python (the default). A
+    def _compiled_term(self) -> tuple[Any, FloatArray] | None:
+        """How the compiled step loop evaluates this controller on its one rigid body: its
+        kernel (signature :data:`CONTROL_KERNEL`) and packed parameters, or None when it is
+        called in Python (the default). A
         built-in controller returns its term only when its ``control`` is not overridden
         (:meth:`_methods_are`)."""
         return None

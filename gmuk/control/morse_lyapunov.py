@@ -66,7 +66,7 @@ The corrected law is written once, as numba kernels in this module:
 :class:`~gmuk.orbits.LVLHReference`, the nominal evaluated in the kernel). The Python methods
 (:meth:`MorseLyapunovController.control`, :meth:`~MorseLyapunovController.errors`,
 :func:`morse_s`, :func:`morse_s_rate_matrix`) call them, and so does the compiled step loop
-(:func:`gmuk.control._kernels.apply_control`); the printed law reuses :func:`morse_s` and Eq.
+(through :data:`~gmuk.control.base.CONTROL_KERNEL`); the printed law reuses :func:`morse_s` and Eq.
 90's bound.
 
 References
@@ -261,6 +261,7 @@ def morse_lyapunov_lvlh(t, g, V, a_model, z, p, u, psi):  # type: ignore[no-unty
     Vdn = np.empty(6)
     lvlh_state_packed(t, p, gn, Vn, Vdn)
     morse_lyapunov_law(g, V, a_model, z, gn, Vn, Vdn, p[13:], u, psi)
+    return 0
 
 
 def _f64(x: Any) -> FloatArray:
@@ -540,12 +541,11 @@ class MorseLyapunovController(Controller):
             ]
         ).astype(float)
 
-    def _compiled_term(self) -> tuple[int, FloatArray] | None:
-        """How the compiled step loop evaluates this law (:func:`morse_lyapunov_lvlh` through
-        gmuk.control._kernels): the code and the packed parameters (:data:`N_LVLH_PARAMS`), or
+    def _compiled_term(self) -> tuple[Any, FloatArray] | None:
+        """How the compiled step loop evaluates this law: its kernel
+        (:func:`morse_lyapunov_lvlh`) and the packed parameters (:data:`N_LVLH_PARAMS`), or
         None (the thesis variant, a user's bound, a reference other than an LVLHReference, an
         overridden ``control``) when it is called in Python."""
-        from gmuk.control import _kernels
         from gmuk.orbits.lvlh import LVLHReference
 
         if (
@@ -558,7 +558,7 @@ class MorseLyapunovController(Controller):
         o = self.reference.orbit
         orbit = [o.mean_motion, o.e, o.mu, o.p, *np.ravel(self.reference._R_NP)]
         params = np.concatenate([orbit, self._law_params()]).astype(float)
-        return _kernels.MORSE_LYAPUNOV_LVLH, params
+        return morse_lyapunov_lvlh, params
 
     def _robust_bound(self, t: float, g: FloatArray, V: FloatArray) -> FloatArray:
         """Eq. 90's κ₂ O/‖r‖⁴, or the user's bound (6,)."""

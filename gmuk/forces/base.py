@@ -11,13 +11,13 @@ A model declares the kinds of body it acts on in :attr:`ForceModel.acts_on`; by 
 kinds whose method it implements (``wrench`` → rigid bodies, ``force`` → point masses). The
 System checks that declaration once, when it is built.
 
-A built-in model with a compiled form writes its physics once, as a numba kernel beside its
-class with the signature of :func:`gmuk.forces._kernels.apply_term` (less the code):
-``kernel(rigid, t, g, V, m, J, p, field, out) -> status``. The class names it ``_kernel`` and
-packs its parameters in ``_kernel_params(body)``; its ``wrench``/``force`` call it through
-:meth:`ForceModel._kernel_load` and the compiled step loop through ``apply_term``, which
-dispatches on the code :meth:`ForceModel._compiled_term` finds for the kernel. Such a kernel
-writes a force at the centre of mass with :func:`com_load`.
+A model with a compiled form writes its physics once, as a numba kernel beside its class with
+the signature :data:`FORCE_KERNEL`: ``kernel(rigid, t, g, V, m, J, p, field, out) -> status``.
+The class names it ``_kernel`` and packs its parameters in ``_kernel_params(body)``; its
+``wrench``/``force`` call it through :meth:`ForceModel._kernel_load`, and the compiled step loop
+calls the same compiled function through its address (:func:`gmuk._numba.kernel_address`):
+nothing else lists the kernel, so a new model with a compiled form touches its own module
+only. Such a kernel writes a force at the centre of mass with :func:`com_load`.
 """
 
 from __future__ import annotations
@@ -26,10 +26,11 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, ClassVar, cast
 
 import numpy as np
+from numba import types as numba_types
 
 from gmuk._forms import DeclaresForms
 from gmuk._frozen import FreezesInSystem
-from gmuk._numba import njit
+from gmuk._numba import C1, C1_READONLY, C2, njit
 from gmuk._validation import FloatArray, check_sequence, distinct_bodies, strict_bool
 from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError, DomainError
@@ -38,13 +39,28 @@ if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
     from gmuk.state import State
 
-__all__ = ["ForceModel", "com_load"]
+__all__ = ["FORCE_KERNEL", "ForceModel", "com_load"]
+
+#: The signature of a force model's kernel, as the compiled loop calls it:
+#: ``(rigid, t, g (4, 4), V (6,), m, J (3, 3), p, field (read-only), out) -> status``, with
+#: ``out`` the body-frame wrench [L; f] (6,) of a rigid body or the force f_N (3,) on a point
+#: mass (then at ``g[:3, 3]`` with velocity ``V[:3]``), and status 0 or a nonzero failure code.
+FORCE_KERNEL = numba_types.int64(
+    numba_types.boolean, numba_types.float64, C2, C1, numba_types.float64, C2, C1, C1_READONLY, C1
+)
 
 # the kernels' arguments that a body or a model does not have (read-only, as the compiled
 # loop passes its field data: the Python calls then use the loop's compiled kernels)
 _NO_INERTIA = np.zeros((3, 3))
 _NO_FIELD = np.zeros(1)
 _NO_FIELD.setflags(write=False)
+
+
+def _read_only(data: Any) -> FloatArray:
+    """A read-only float64 view of field data: the type the loop passes the kernel."""
+    view = np.asarray(data, dtype=float).view()
+    view.setflags(write=False)
+    return view
 
 
 @njit(cache=True)
@@ -183,24 +199,19 @@ class ForceModel(FreezesInSystem, DeclaresForms):
         """
         raise DefinitionError(f"{self.name} does not act on point masses")
 
-    def _compiled_term(self, body: Body) -> tuple[int, tuple[float, ...], Any] | None:
-        """How the compiled step loop evaluates this model on ``body``: (code of its kernel in
-        :mod:`gmuk.forces._kernels`, parameters, field data vector or None), or None when the
-        model has no compiled form and is called in Python. A model has the compiled form of
-        the class that defines its ``_kernel`` when its ``wrench``, ``force`` and
+    def _compiled_term(self, body: Body) -> tuple[Any, tuple[float, ...], Any] | None:
+        """How the compiled step loop evaluates this model on ``body``: (its kernel, with the
+        signature :data:`FORCE_KERNEL`; parameters; field data vector or None), or None when
+        the model has no compiled form and is called in Python. A model has the compiled form
+        of the class that defines its ``_kernel`` when its ``wrench``, ``force`` and
         ``wrenches`` are that class's (a subclass that overrides one of them has none), and
         when ``_kernel_params(body)`` packs parameters for the body."""
         kernel = self._declared_form("_kernel")
-        if kernel is None:
-            return None
-        from gmuk.forces._kernels import CODES
-
-        code = CODES.get(kernel)
-        packed = self._kernel_params(body) if code is not None else None
-        if code is None or packed is None:
+        packed = self._kernel_params(body) if kernel is not None else None
+        if packed is None:
             return None
         params, data = packed
-        return code, tuple(float(v) for v in params), data
+        return kernel, tuple(float(v) for v in params), data
 
     def _kernel_params(self, body: Body) -> tuple[Any, Any] | None:
         """The parameters of :attr:`_kernel` for ``body`` and the field data vector (or
@@ -237,7 +248,7 @@ class ForceModel(FreezesInSystem, DeclaresForms):
             J = _NO_INERTIA
             out = np.empty(3)
         p = np.array(params, dtype=float)
-        field = _NO_FIELD if data is None else data
+        field = _NO_FIELD if data is None else _read_only(data)
         status = self._kernel(rigid, float(t), g, V, float(body.mass), J, p, field, out)
         if status != 0:
             raise self._kernel_failure(int(status), float(t), g)

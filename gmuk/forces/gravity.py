@@ -16,7 +16,7 @@
 Each model's formula is written once, in the numba kernel beside its class
 (:func:`point_mass_load`, :func:`gravity_gradient_load`, :func:`harmonic_point_load`): the
 class's ``wrench``/``force`` call it, and so does the compiled step loop
-(:func:`gmuk.forces._kernels.apply_term`).
+(through :data:`~gmuk.forces.base.FORCE_KERNEL`).
 """
 
 from __future__ import annotations

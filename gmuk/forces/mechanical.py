@@ -2,7 +2,7 @@
 
 :class:`UniformGravity` and :class:`LinearSpringDamper` are written once each, in the numba
 kernel beside the class (:func:`uniform_load`, :func:`spring_load`) that their Python methods
-and the compiled step loop (:func:`gmuk.forces._kernels.apply_term`) both call; their CasADi
+and the compiled step loop (through :data:`~gmuk.forces.base.FORCE_KERNEL`) both call; their CasADi
 forms, and those of the other models here, are methods of the classes.
 """
 

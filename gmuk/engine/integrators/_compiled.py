@@ -49,10 +49,11 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-from gmuk._numba import njit
-from gmuk.constraints._kernels import apply_rows
-from gmuk.control._kernels import apply_control
-from gmuk.engine._uk_kernels import _qr_solve, rigid_free_accel, uk_rigid
+from gmuk._numba import kernel_caller, njit
+from gmuk.constraints.base import ROWS_KERNEL
+from gmuk.control.base import CONTROL_KERNEL
+from gmuk.dynamics import rigid_free_accel
+from gmuk.engine._uk_kernels import _qr_solve, uk_rigid
 from gmuk.engine.integrators import _dop853_tableau as _tab
 from gmuk.engine.integrators._program import (
     FUSED,
@@ -64,8 +65,7 @@ from gmuk.engine.integrators._program import (
     Program,
     reference_records,
 )
-from gmuk.forces._kernels import apply_term
-from gmuk.gravity import _kernels as _field_kernels
+from gmuk.forces.base import FORCE_KERNEL
 from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
 
 __all__ = ["Status", "advance", "compile_loop", "loaded"]
@@ -97,7 +97,7 @@ I_RHS = 3  #: right-hand side evaluations
 I_WRITTEN = 4  #: rows written to the output buffers in this chunk
 I_MAX_STEPS = 5  #: the step budget
 I_CHUNK = 6  #: steps per chunk
-I_FIELD = 7  #: a failed force kernel's code
+I_FIELD = 7  #: a failed part kernel's status
 I_NEED = 8  #: output rows the next step needs (status FULL)
 I_STARTED = 9  #: 0 until the first evaluation at the start time is done
 I_FRESH = 10  #: 1 for a run from its initial state, 0 for one resumed from a checkpoint
@@ -114,6 +114,12 @@ N_FLOATS = 8
 
 
 # ------------------------------------------------------------------------ right-hand side
+# The parts' kernels, called through the addresses in the program's tables (gmuk._numba).
+_call_force = kernel_caller(FORCE_KERNEL, "force model")
+_call_rows = kernel_caller(ROWS_KERNEL, "constraint")
+_call_control = kernel_caller(CONTROL_KERNEL, "controller")
+
+
 @intrinsic
 def _call_back(typingctx, address, phase):  # type: ignore[no-untyped-def]
     """Call the C function ``int64 f(int64 phase)`` at ``address`` (a ctypes callback)."""
@@ -159,7 +165,7 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
     (:func:`aux_layout`: total acceleration, unmodeled generalized forces, constraint
     acceleration, constraint wrenches M ν̇_c, multipliers λ, the solve's residual, the
     controllers' generalized forces, their states' rates ż, the rank of A). Returns a
-    :class:`Status`: DONE, NONFINITE, CALLBACK, or FIELD with the force kernel's code in
+    :class:`Status`: DONE, NONFINITE, CALLBACK, or FIELD with the failed kernel's status in
     ``ints[I_FIELD]``."""
     d = parts.dims
     r_off, e_off, io = parts.rigid_offsets, parts.euclid_offsets, parts.io
@@ -235,20 +241,18 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
     no_inertia = np.zeros((3, 3))
     x0 = 12 * nr
     for f in range(terms.shape[0]):
-        code, rig, idx, off = terms[f, 0], terms[f, 1], terms[f, 2], terms[f, 3]
+        kernel, rig, idx, off = terms[f, 0], terms[f, 1], terms[f, 2], terms[f, 3]
         p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]
         if rig:
-            status = apply_term(
-                code, rig != 0, t, g[idx], V[idx], m_r[idx], J[idx], params[p0:], fdata[f0:f1], w
-            )
+            args = (True, t, g[idx], V[idx], m_r[idx], J[idx], params[p0:], fdata[f0:f1], w)
+            status = _call_force(kernel, args)
             dof = 6
         else:
             for i in range(3):
                 gp[i, 3] = Y[x0 + idx + i]
                 vp[i] = Y[x0 + ne + idx + i]
-            status = apply_term(
-                code, rig != 0, t, gp, vp, m_e[idx], no_inertia, params[p0:], fdata[f0:f1], w
-            )
+            args = (False, t, gp, vp, m_e[idx], no_inertia, params[p0:], fdata[f0:f1], w)
+            status = _call_force(kernel, args)
             dof = 3
         if status != 0:  # the failing state to io, where Python describes the failure
             ints[I_FIELD] = status
@@ -348,16 +352,19 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
         for i in range(nc):
             z_dot[i] = io[ca + 2 * ndof + i]
     ctrls, ctrl_params = parts.ctrls, parts.ctrl_params
-    if ctrls.shape[0]:  # the compiled controllers (gmuk.control._kernels)
+    if ctrls.shape[0]:  # the compiled controllers (their kernels' addresses in ctrls)
         u = np.empty(6)
         zd = np.empty(6)
         zs = x0 + 2 * ne
         for c in range(ctrls.shape[0]):
-            code, k, o, z0, p0 = ctrls[c, 0], ctrls[c, 1], ctrls[c, 2], ctrls[c, 3], ctrls[c, 4]
-            apply_control(
-                code, t, g[k], V[k], total[o : o + 6], Y[zs + z0 : zs + z0 + 6],
-                ctrl_params[p0:], u, zd,
-            )  # fmt: skip
+            kernel, k, o, z0, p0 = ctrls[c, 0], ctrls[c, 1], ctrls[c, 2], ctrls[c, 3], ctrls[c, 4]
+            z = Y[zs + z0 : zs + z0 + 6]
+            args = (t, g[k], V[k], total[o : o + 6], z, ctrl_params[p0:], u, zd)
+            status = _call_control(kernel, args)
+            if status != 0:
+                ints[I_FIELD] = status
+                _write_state(t, g, V, Y, d, io)
+                return FIELD
             for i in range(6):
                 control[o + i] += u[i]
                 z_dot[z0 + i] = zd[i]
@@ -393,7 +400,7 @@ def _apply_M(a, J, m_r, m_e, r_off, e_off, out):  # type: ignore[no-untyped-def]
 @njit(cache=True)
 def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[no-untyped-def]
     """The stacked rows (A, b) of the constraints, as their ``rows`` give them: computed by
-    their kernels (gmuk.constraints._kernels; a rigid body's columns start at its offset in
+    their kernels (through the addresses in ``cons``; a rigid body's columns start at its offset in
     ν, ``r_off``), or copied from ``io`` where PythonParts wrote them. Returns 0 or the
     status of a failed kernel."""
     ndof = A.shape[1]
@@ -415,7 +422,7 @@ def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[n
         Ak = np.empty((nrow, 12))
         bk = np.empty(nrow)
         second = j if j >= 0 else i
-        status = apply_rows(kind, t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk)
+        status = _call_rows(kind, (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
         if status != 0:
             return status
         for a in range(nrow):
@@ -964,10 +971,6 @@ def compile_loop(*, announce: bool = True, timeout: float = 900.0) -> bool:
 
 
 def _compile_now() -> None:
-    # The force kernels call the field kernel's one compiled signature (read-only data):
-    # resolving it first loads it (or compiles it once) and keeps the loop from compiling
-    # a second copy for other argument types.
-    _field_kernels.ENTRIES.acceleration_at  # noqa: B018
     advance.compile(signature())
     global _ready
     _ready = True

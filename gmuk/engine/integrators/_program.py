@@ -18,10 +18,14 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
+from gmuk._numba import kernel_address
 from gmuk.bodies import Body, BodyKind
+from gmuk.constraints.base import ROWS_KERNEL
+from gmuk.control.base import CONTROL_KERNEL
 from gmuk.engine.integrators._base import RungeKuttaMethod
 from gmuk.engine.integrators.dop853 import DOP853
 from gmuk.errors import ConstraintError, DefinitionError
+from gmuk.forces.base import FORCE_KERNEL
 
 if TYPE_CHECKING:
     from gmuk.state import Layout, State
@@ -50,7 +54,7 @@ PHASE_ACCELERATIONS = 2  #: the whole acceleration in Python (System._accelerati
 
 
 #: The constraint table's kind of a constraint whose rows come from Python (PythonParts, at
-#: io[p0:]); the others hold their kernel's code (gmuk.constraints._kernels).
+#: io[p0:]); the others hold their kernel's address (gmuk._numba.kernel_address).
 PYTHON = -1
 
 
@@ -123,7 +127,7 @@ class Dims(NamedTuple):
 class Parts(NamedTuple):
     """A System's compiled form, as the kernels take it."""
 
-    #: (n_terms, 8) int64: code, rigid, body index, ν offset, modeled, parameter start,
+    #: (n_terms, 8) int64: kernel address, rigid, body index, ν offset, modeled, parameter start,
     #: field start, field end
     terms: np.ndarray
     params: np.ndarray
@@ -142,7 +146,7 @@ class Parts(NamedTuple):
     uk_params: np.ndarray
     #: the buffer shared with the Python callback
     io: np.ndarray
-    #: (n_ctrl, 5) int64: code, body index, ν offset, z offset, parameter start
+    #: (n_ctrl, 5) int64: kernel address, body index, ν offset, z offset, parameter start
     ctrls: np.ndarray
     ctrl_params: np.ndarray
     #: where the point masses' 3-vectors start in Y (positions, then velocities)
@@ -332,11 +336,12 @@ def build(view: SystemView, method: RungeKuttaMethod, state: State) -> Program:
         uk_params[0] = min(QR_COND_LIMIT, 0.1 / rcond)
     ctrl_rows: list[list[int]] = []
     ctrl_params: list[float] = []
-    for k, (code, values) in ctrl_plan:
+    for k, (kernel, values) in ctrl_plan:
         body = view.controller_bodies[k][0]
         slot = lay.slot(body)
         z0 = int(view.controller_slices[k].start)
-        ctrl_rows.append([code, slot.index, slot.offset, z0, len(ctrl_params)])
+        address = kernel_address(kernel, CONTROL_KERNEL)
+        ctrl_rows.append([address, slot.index, slot.offset, z0, len(ctrl_params)])
         ctrl_params.extend(np.asarray(values, dtype=float).tolist())
     python = PythonParts(view, py_forces, cons, py_constraints, py_controllers, n_rows)
     points = [lay.slot(b).index for b in view.bodies if b.kind is BodyKind.POINT]
@@ -379,7 +384,7 @@ def build(view: SystemView, method: RungeKuttaMethod, state: State) -> Program:
 
 
 def _force_plan(view: SystemView) -> tuple[list[tuple[Any, ...]], list[Any]]:
-    """The compiled terms ``(code, values, data, rigid, index, offset, modeled)`` of the force
+    """The compiled terms ``(kernel, values, data, rigid, index, offset, modeled)`` of the force
     models that have a compiled form on every body they act on, and the other models'
     entries of the System's force plan (evaluated in Python)."""
     terms: list[tuple[Any, ...]] = []
@@ -392,8 +397,8 @@ def _force_plan(view: SystemView) -> tuple[list[tuple[Any, ...]], list[Any]]:
             continue
         for (_body, rigid, index, offset, _dof), term in zip(slots, compiled_terms, strict=True):
             assert term is not None
-            code, values, data = term
-            terms.append((code, values, data, rigid, index, offset, f.modeled))
+            kernel, values, data = term
+            terms.append((kernel, values, data, rigid, index, offset, f.modeled))
     return terms, py_forces
 
 
@@ -404,7 +409,7 @@ def _pack_terms(plan: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray, np
     fields: list[np.ndarray] = []
     field_at: dict[int, tuple[int, int]] = {}
     n_field = 0
-    for code, values, data, rigid, index, offset, modeled in plan:
+    for kernel, values, data, rigid, index, offset, modeled in plan:
         f0 = f1 = 0
         if data is not None:
             if id(data) not in field_at:
@@ -412,7 +417,8 @@ def _pack_terms(plan: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray, np
                 fields.append(np.asarray(data, dtype=float))
                 n_field += data.size
             f0, f1 = field_at[id(data)]
-        terms.append([code, int(rigid), index, offset, int(modeled), len(params), f0, f1])
+        address = kernel_address(kernel, FORCE_KERNEL)
+        terms.append([address, int(rigid), index, offset, int(modeled), len(params), f0, f1])
         params.extend(float(v) for v in values)
     field_data = np.concatenate(fields) if fields else np.zeros(1)
     field_data.setflags(write=False)
@@ -424,7 +430,7 @@ def _pack_terms(plan: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray, np
 
 
 def _controller_plan(view: SystemView) -> tuple[list[tuple[int, Any]], list[int]]:
-    """The controllers with a compiled term on one rigid body ``(k, (code, values))``, and
+    """The controllers with a compiled term on one rigid body ``(k, (kernel, values))``, and
     the numbers of the others (called back in Python)."""
     compiled: list[tuple[int, Any]] = []
     python: list[int] = []
@@ -611,9 +617,10 @@ def _constraint_program(view: SystemView, solve: int) -> tuple[np.ndarray, np.nd
             # rows from Python; program() sets their count and place
             rows.append([PYTHON, 0, -1, 0, 0, 0])
             continue
-        code, values, n_rows = term
+        kernel, values, n_rows = term
+        address = kernel_address(kernel, ROWS_KERNEL)
         idx = [view.layout.slot(b).index for b in bodies]
-        rows.append([code, idx[0], idx[1] if len(idx) == 2 else -1, 0, n_rows, len(params)])
+        rows.append([address, idx[0], idx[1] if len(idx) == 2 else -1, 0, n_rows, len(params)])
         params += values
     cons = np.array(rows, dtype=np.int64).reshape(-1, 6)
     if solve == FUSED:  # a writable copy: every program has the same argument types
