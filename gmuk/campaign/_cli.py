@@ -26,6 +26,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from gmuk.campaign.core import MAX_RUNS
 from gmuk.campaign.dispersions import (
     AttitudeCone,
     Choice,
@@ -120,7 +121,14 @@ def _sweep(text: str) -> tuple[str, list[Any]]:
             raise OptionError(f"--sweep {text!r}: LO:HI[:STEP] takes integers") from None
         if len(parts) > 3 or (step and step[0] < 1) or hi < lo:
             raise OptionError(f"--sweep {text!r}: need LO ≤ HI and STEP ≥ 1")
-        return name, list(range(lo, hi + 1, step[0] if step else 1))
+        values = range(lo, hi + 1, step[0] if step else 1)
+        count = (hi - lo) // (step[0] if step else 1) + 1  # len(values), without overflow
+        if count > MAX_RUNS:
+            raise OptionError(
+                f"--sweep {text!r}: {count:,} values; a campaign runs at most {MAX_RUNS:,} "
+                "(gmuk.campaign.core.MAX_RUNS)"
+            )
+        return name, list(values)
     try:
         return name, _integers(spec, "--sweep")
     except OptionError:
@@ -152,7 +160,10 @@ def _parser() -> argparse.ArgumentParser:
 
     p.add_argument("scenario", nargs="?", help=", ".join(supported()))
     p.add_argument(
-        "--runs", type=int, default=None, help="number of runs (default: the sweep's size)"
+        "--runs",
+        type=int,
+        default=None,
+        help=f"number of runs, at most {MAX_RUNS:,} (default: the sweep's size)",
     )
     p.add_argument("--seed", type=int, default=0, help="seed of the dispersions (default 0)")
     p.add_argument(

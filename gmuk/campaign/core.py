@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import ctypes
 import hashlib
+import itertools
 import math
 import os
 import signal
@@ -12,7 +14,7 @@ import threading
 import time
 import traceback
 from collections.abc import Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -22,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from gmuk import runs as _runs
+from gmuk._locks import folder_lock
 from gmuk.campaign import store as _store
 from gmuk.campaign.dispersions import Dispersion, check_sequence, dispersion_from_dict, magnitude
 from gmuk.campaign.models import CampaignModel, FunctionModel, get_model, model_from_dict
@@ -31,6 +34,12 @@ __all__ = ["Campaign", "CampaignReport", "resume"]
 
 #: Seconds to wait for a Dask scheduler to answer before giving up.
 CONNECT_TIMEOUT_S = 5.0
+
+#: The most runs in one campaign (and values in one sweep): ten million. The folder keeps a
+#: row per run and a resume reads the finished runs' indices, so a campaign stays within a
+#: few GB at this size; a larger one is refused when it is defined, before any folder is made
+#: (split it into campaigns of other seeds). Runs are enumerated lazily, never listed.
+MAX_RUNS = 10_000_000
 
 
 def _stream_key(name: str) -> int:
@@ -53,7 +62,8 @@ class Campaign:
         A scenario with campaign support (``"fcei"``, ``"ucei"``, ``"apollo16"``:
         :func:`gmuk.campaign.supported`) or a model (e.g. :meth:`from_function`).
     runs : int, optional
-        Number of runs (≥ 1). Default: the number of grid points; required without a grid.
+        Number of runs, 1 to :data:`MAX_RUNS` (ten million). Default: the number of grid
+        points; required without a grid.
     seed : int
         Seed (≥ 0). Run k's random values come from ``SeedSequence(seed, spawn_key=(k,
         key(name)))`` for each dispersed parameter ``name`` alone, so a run is the same on any
@@ -113,7 +123,10 @@ class Campaign:
             model.parameter(name).check_dispersion(d)
         fixed = {k: model.parameter(k).check(v) for k, v in fixed.items()}
         grid = {
-            k: tuple(model.parameter(k).check(v) for v in check_sequence(vals, f"grid[{k!r}]"))
+            k: tuple(
+                model.parameter(k).check(v)
+                for v in check_sequence(vals, f"grid[{k!r}]", limit=MAX_RUNS)
+            )
             for k, vals in grid_in.items()
         }
         points = math.prod(len(v) for v in grid.values())
@@ -122,6 +135,13 @@ class Campaign:
             raise DefinitionError(
                 f"runs must be an integer ≥ 1 (the default is the grid's size, without a grid "
                 f"give it); got {self.runs!r}"
+            )
+        if runs > MAX_RUNS:
+            what = "the grid's size" if self.runs is None else "runs"
+            raise DefinitionError(
+                f"{what} must be at most {MAX_RUNS:,} (gmuk.campaign.core.MAX_RUNS, the most "
+                f"runs a campaign folder holds); got {int(runs):,}. Split the campaign into "
+                "several of other seeds"
             )
         if (
             isinstance(self.seed, bool)
@@ -266,6 +286,8 @@ class Campaign:
         GmukError
             Bad ``workers``, an unreachable scheduler, a folder that holds a campaign or
             cannot be made — before any run starts.
+        gmuk._locks.FolderInUseError
+            Another live process (a campaign or a resume) owns the folder.
 
         Notes
         -----
@@ -274,15 +296,28 @@ class Campaign:
         run in progress stops at its next step and is not recorded, and on Dask the runs not
         yet finished are cancelled (Dask does not tell a queued task from a running one).
         Continue with :func:`resume`.
+
+        The call owns the folder while it runs (a lock on ``out/.gmuk.lock``,
+        :mod:`gmuk._locks`): another campaign or resume of it is refused, so no run is
+        computed twice. The kernel releases the lock when the process ends, however it ends.
+        Local worker processes die with the campaign's process, even when it is killed
+        (SIGKILL): they are started with a parent-death signal on Linux and watch their
+        parent's pid everywhere.
         """
         backend = _backend(workers, scheduler, connect_timeout_s)
         st = _store.ResultStore(out)
-        try:
-            st.create(_manifest(self))
-        except BaseException:
-            backend.close()
-            raise
-        return _drive(self, st, backend, progress)
+        with ExitStack() as owned:
+            try:
+                try:
+                    st.out.mkdir(parents=True, exist_ok=True)
+                except OSError as exc:
+                    raise GmukError(f"cannot make the campaign folder {st.out}: {exc}") from None
+                owned.enter_context(_own(st.out))
+                st.create(_manifest(self))
+            except BaseException:
+                backend.close()
+                raise
+            return _drive(self, st, backend, progress)
 
 
 def resume(
@@ -297,11 +332,30 @@ def resume(
 
     The campaign's definition comes from ``out/manifest.json``; ``workers``, ``scheduler`` and
     ``progress`` as for :meth:`Campaign.run` (they do not change any run's result).
+
+    Raises
+    ------
+    gmuk._locks.FolderInUseError
+        Another live process is running or resuming this campaign (two at once would compute
+        every pending run twice); nothing is started.
     """
     st = _store.ResultStore(out)
     campaign = Campaign.from_dict(st.manifest()["campaign"])
-    backend = _backend(workers, scheduler, connect_timeout_s)
-    return _drive(campaign, st, backend, progress)
+    with _own(st.out):
+        backend = _backend(workers, scheduler, connect_timeout_s)
+        return _drive(campaign, st, backend, progress)
+
+
+@contextmanager
+def _own(out: Path) -> Iterator[None]:
+    """Hold the campaign folder's lock (one campaign process per folder; gmuk._locks)."""
+    with folder_lock(
+        out,
+        "gmuk campaign",
+        hint="it is being run or resumed already: wait for it to end (gmuk campaign --summary "
+        "reads it meanwhile)",
+    ):
+        yield
 
 
 def load_campaign(out: str | Path) -> Campaign:
@@ -398,8 +452,41 @@ TASK_RUNS_MAX = 64
 
 
 def _ignore_sigint() -> None:
-    """Worker-process initializer: the parent alone decides when a campaign stops."""
+    """The parent alone decides when a campaign stops."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+#: Linux's ``prctl`` option that sends the process a signal when its parent dies.
+_PR_SET_PDEATHSIG = 1
+#: How often a worker checks that its parent is alive (s), where prctl is not available.
+PARENT_POLL_S = 1.0
+
+
+def _worker_init(parent: int) -> None:
+    """Worker-process initializer: ignore SIGINT (:func:`_ignore_sigint`) and die with the
+    campaign's process ``parent``, even when it is killed by SIGKILL — by a parent-death
+    signal (SIGKILL) on Linux, and everywhere by a daemon thread that ends the worker once
+    its parent pid changes (the parent is gone: the worker was re-parented)."""
+    _ignore_sigint()
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - no prctl: the thread below
+            pass
+    if os.getppid() != parent:  # the parent died before the signal was armed
+        os._exit(1)
+    threading.Thread(
+        target=_watch_parent, args=(parent,), name="gmuk-parent-watch", daemon=True
+    ).start()
+
+
+def _watch_parent(parent: int) -> None:
+    """End this worker process once ``parent`` is no longer its parent."""
+    while True:
+        time.sleep(PARENT_POLL_S)
+        if os.getppid() != parent:
+            os._exit(1)
 
 
 class _Backend:
@@ -436,7 +523,10 @@ class _Processes(_Backend):
         self.slots = workers
         self.own = pool is None
         self.pool = pool or ProcessPoolExecutor(
-            workers, mp_context=multiprocessing.get_context("spawn"), initializer=_ignore_sigint
+            workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_worker_init,
+            initargs=(os.getpid(),),
         )
 
     def submit(self, campaign: Campaign, ks: list[int], out: str) -> Any:
@@ -649,7 +739,9 @@ def _drive(
     try:
         st.compact()
         done = st.finished()
-        todo = [k for k in range(campaign.n_runs) if k not in done]
+        # the runs to do, enumerated lazily (a campaign may hold up to MAX_RUNS runs)
+        todo = (k for k in range(campaign.n_runs) if k not in done)
+        left = campaign.n_runs - sum(1 for k in done if 0 <= k < campaign.n_runs)
         show = sys.stderr.isatty() if progress is None else bool(progress)
         bar = tqdm(
             total=campaign.n_runs,
@@ -684,19 +776,20 @@ def _drive(
                             break
                         store([execute(campaign, k, out)])
             else:
-                queue = list(reversed(todo))  # popped from the end: in run order
                 running: set[Any] = set()
                 window = 2 * backend.slots + 2  # tasks queued ahead, so no worker waits
                 per_task = 1  # runs per task, from the runs' own times once some are known
                 times: list[float] = []
                 while True:
                     if not stop.signals:
-                        while queue and len(running) < window:
+                        while left > 0 and len(running) < window:
                             # never so many per task that a worker is left without one
-                            share = -(-len(queue) // (2 * backend.slots))
+                            share = -(-left // (2 * backend.slots))
                             n = max(1, min(per_task, share))
-                            ks = [queue.pop() for _ in range(min(n, len(queue)))]
-                            running.add(backend.submit(campaign, ks, out))
+                            ks = list(itertools.islice(todo, n))  # in run order
+                            left = left - len(ks) if ks else 0
+                            if ks:
+                                running.add(backend.submit(campaign, ks, out))
                     elif len(stop.signals) == 1 and running:
                         backend.cancel(running)
                     if len(stop.signals) > 1:

@@ -43,6 +43,7 @@ axis–angle form).
 from __future__ import annotations
 
 import abc
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
@@ -409,14 +410,29 @@ def magnitude(kind: str, value: Any) -> float:
     return float(value)
 
 
-def check_sequence(values: Sequence[Any], owner: str) -> tuple[Any, ...]:
-    """``values`` as a non-empty tuple (grid sweeps)."""
+def check_sequence(values: Sequence[Any], owner: str, limit: int | None = None) -> tuple[Any, ...]:
+    """``values`` as a non-empty tuple (grid sweeps) of at most ``limit`` values: a longer
+    sequence (a ``range(10**20)``, an endless iterator) is refused before it is stored."""
     if isinstance(values, (str, bytes)):
         raise DefinitionError(f"{owner}: expected a sequence of values; got {values!r}")
+    too_many = DefinitionError(
+        f"{owner}: the sweep has more than {limit} values (the most a campaign runs: "
+        "gmuk.campaign.core.MAX_RUNS)"
+    )
+    if limit is not None and hasattr(values, "__len__"):
+        try:
+            if len(values) > limit:
+                raise too_many
+        except OverflowError:  # len(range(10**20)): beyond an index
+            raise too_many from None
+        except TypeError:
+            pass
     try:
-        out = tuple(values)
+        out = tuple(values if limit is None else itertools.islice(values, limit + 1))
     except TypeError:
         raise DefinitionError(f"{owner}: expected a sequence of values; got {values!r}") from None
+    if limit is not None and len(out) > limit:
+        raise too_many
     if not out:
         raise DefinitionError(f"{owner}: the sweep has no values")
     return out
