@@ -1,7 +1,7 @@
 """Folders owned by one live process at a time: ``gmuk run``'s output folder and a campaign's
 folder.
 
-:func:`folder_lock` takes an exclusive :func:`fcntl.flock` lock on ``FOLDER/.gmuk.lock`` and
+:func:`folder_lock` takes an exclusive :func:`fcntl.flock` lock on ``FOLDER/.gmuk-lock`` and
 writes into that file who holds it (process id, host name, start time, what for). The lock
 belongs to the open file, which belongs to the process: the kernel releases it when the
 process ends, however it ends (SIGKILL, a crash, a power cut of the machine), so a killed run
@@ -39,7 +39,7 @@ from gmuk.errors import GmukError, GmukWarning
 __all__ = ["LOCK_NAME", "FolderInUseError", "folder_lock", "holder"]
 
 #: The lock file's name inside the folder it guards.
-LOCK_NAME = ".gmuk.lock"
+LOCK_NAME = ".gmuk-lock"
 
 #: Times a lock is taken again when the file locked was removed meanwhile (see module doc).
 _ATTEMPTS = 20

@@ -26,7 +26,7 @@ process (SIGKILL, a power cut) loses at most one interval; ``gmuk run --resume D
 the run with the options it was started with. A run that completes removes its checkpoints.
 
 One run at a time owns an output folder: ``gmuk run`` (and ``--resume``) holds a lock on
-``DIR/.gmuk.lock`` (:mod:`gmuk._locks`; the file names the process, host and start time) for
+``DIR/.gmuk-lock`` (:mod:`gmuk._locks`; the file names the process, host and start time) for
 as long as it runs. A second run into the same folder is refused at once with a
 :class:`~gmuk._locks.FolderInUseError` naming the first (exit status 2) and changes nothing
 there. The kernel releases the lock when its process ends, however it ends: a killed run never

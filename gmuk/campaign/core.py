@@ -297,7 +297,7 @@ class Campaign:
         yet finished are cancelled (Dask does not tell a queued task from a running one).
         Continue with :func:`resume`.
 
-        The call owns the folder while it runs (a lock on ``out/.gmuk.lock``,
+        The call owns the folder while it runs (a lock on ``out/.gmuk-lock``,
         :mod:`gmuk._locks`): another campaign or resume of it is refused, so no run is
         computed twice. The kernel releases the lock when the process ends, however it ends.
         Local worker processes die with the campaign's process, even when it is killed

@@ -133,7 +133,7 @@ def test_a_second_campaign_resume_while_one_runs_is_refused_and_no_run_is_comput
     starts = [k for what, k in attempts if what == "start"]
     assert sorted(starts) == list(range(RUNS))  # every run computed once, none twice
     assert read_table(out).column("run").to_pylist() == list(range(RUNS))
-    assert not (out / ".gmuk.lock").exists()
+    assert not (out / ".gmuk-lock").exists()
 
 
 SLEEPY = '''
