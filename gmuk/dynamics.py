@@ -23,7 +23,6 @@ __all__ = [
     "free_acceleration",
     "g_ddot",
     "kinetic_energy",
-    "rigid_free_accel",
     "spatial_inertia",
     "spatial_momentum",
 ]

@@ -322,23 +322,29 @@ def _morse_lyapunov(rng: np.random.Generator) -> Case:
     return Case(ctl, sys, state, modeled=rng.normal(size=6))
 
 
-class _Plan:
-    """What OpenLoopControl reads of an OptimalControlResult: body names and dofs, and the
-    control u(t) (a smooth random function here)."""
+def _plan(rng: np.random.Generator, names: tuple[str, ...], dofs: tuple[int, ...]) -> Any:
+    """An OptimalControlResult standing for a solved problem with what OpenLoopControl reads:
+    body names and dofs, and the control u(t) (a smooth random function here)."""
+    from gmuk.optimize.result import OptimalControlResult
 
-    def __init__(self, rng: np.random.Generator, names: tuple[str, ...], dofs: tuple[int, ...]):
-        self.body_names, self.body_dofs = names, dofs
-        self._c = rng.normal(size=(3, sum(dofs)))
+    c = rng.normal(size=(3, sum(dofs)))
 
-    def control(self, t: float) -> np.ndarray:
-        return self._c[0] + self._c[1] * np.sin(t) + self._c[2] * t
+    class Plan(OptimalControlResult):
+        def __init__(self) -> None:  # a stand-in: none of the solved fields
+            object.__setattr__(self, "body_names", names)
+            object.__setattr__(self, "body_dofs", dofs)
+
+        def control(self, t: float) -> np.ndarray:  # type: ignore[override]
+            return c[0] + c[1] * np.sin(t) + c[2] * t
+
+    return Plan()
 
 
 def _open_loop(rng: np.random.Generator) -> Case:
     from gmuk.optimize.result import OpenLoopControl
 
     bodies = _bodies(rng)
-    ctl = OpenLoopControl(_Plan(rng, ("rigid", "point"), (6, 3)))  # type: ignore[arg-type]
+    ctl = OpenLoopControl(_plan(rng, ("rigid", "point"), (6, 3)))
     case = _case(rng, ctl, bodies, (0.0, 100.0), 10.0)
     case.modeled = rng.normal(size=9)
     return case

@@ -290,14 +290,16 @@ class ConfigurationTracking(Constraint):
         g, V = state.g[i], state.V[i]
         ref = self.reference.evaluate(state.t)
         gd, Vd, Vd_dot = ref.g, ref.V, ref.V_dot
-        # np.asarray costs more than this check when x needs no conversion; compare dtypes
-        # with ==: arrays made by numba kernels carry their own float64 dtype object
-        if type(gd) is not _ndarray or gd.dtype != _F64:
-            gd = np.asarray(gd, dtype=np.float64)
-        if type(Vd) is not _ndarray or Vd.dtype != _F64:
-            Vd = np.asarray(Vd, dtype=np.float64)
-        if type(Vd_dot) is not _ndarray or Vd_dot.dtype != _F64:
-            Vd_dot = np.asarray(Vd_dot, dtype=np.float64)
+        # The kernel takes writable float64 arrays, as the compiled loop passes them (one
+        # compiled signature: a read-only reference array would make numba compile another).
+        # np.array costs more than this check when x needs no conversion; compare dtypes with
+        # ==: arrays made by numba kernels carry their own float64 dtype object.
+        if type(gd) is not _ndarray or gd.dtype != _F64 or not gd.flags.writeable:
+            gd = np.array(gd, dtype=np.float64)
+        if type(Vd) is not _ndarray or Vd.dtype != _F64 or not Vd.flags.writeable:
+            Vd = np.array(Vd, dtype=np.float64)
+        if type(Vd_dot) is not _ndarray or Vd_dot.dtype != _F64 or not Vd_dot.flags.writeable:
+            Vd_dot = np.array(Vd_dot, dtype=np.float64)
         if gd.shape != (4, 4) or Vd.shape != (6,) or Vd_dot.shape != (6,):
             raise ConstraintError(
                 f"constraint {self.name!r}: the reference returned g {gd.shape}, V {Vd.shape}, "

@@ -636,6 +636,7 @@ class _Loop:
         # raises there fails the run at its start time
         prog = p.system.compiled_program(self.method, p.state(t, Y, G0))
         _compiled.compile_loop()
+        ints[_compiled.I_RHS_KERNEL] = _compiled.rhs_address()
         fs[[_compiled.F_T, _compiled.F_END, _compiled.F_RTOL, _compiled.F_ATOL]] = (
             t, args.t1, self.rtol, self.atol,
         )  # fmt: skip

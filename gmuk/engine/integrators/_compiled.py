@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import contextlib
 import enum
+import functools
 import math
 import os
 import sys
@@ -49,7 +50,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-from gmuk._numba import kernel_caller, njit
+from gmuk._numba import kernel_address, kernel_caller, njit
 from gmuk.constraints.base import ROWS_KERNEL
 from gmuk.control.base import CONTROL_KERNEL
 from gmuk.dynamics import rigid_free_accel
@@ -101,7 +102,8 @@ I_FIELD = 7  #: a failed part kernel's status
 I_NEED = 8  #: output rows the next step needs (status FULL)
 I_STARTED = 9  #: 0 until the first evaluation at the start time is done
 I_FRESH = 10  #: 1 for a run from its initial state, 0 for one resumed from a checkpoint
-N_INTS = 11
+I_RHS_KERNEL = 11  #: the address of the compiled :func:`rhs` (:func:`rhs_address`)
+N_INTS = 12
 F_T = 0  #: time of the last accepted step (s)
 F_H = 1  #: the next step size (s); 0 asks the loop for the starting step
 F_END = 2  #: end time (s)
@@ -118,6 +120,22 @@ N_FLOATS = 8
 _call_force = kernel_caller(FORCE_KERNEL, "force model")
 _call_rows = kernel_caller(ROWS_KERNEL, "constraint")
 _call_control = kernel_caller(CONTROL_KERNEL, "controller")
+
+
+def _rhs_signature() -> Any:
+    """:func:`rhs`'s signature: every program's records have the same types."""
+    from numba import typeof
+
+    v, ints, G = np.empty(1), np.empty(1, dtype=np.int64), np.empty((1, 4, 4))
+    parts = reference_records()[0]
+    return types.int64(*(typeof(x) for x in (0.0, v, G, parts, v, v, ints)))
+
+
+#: The signature :func:`rhs` is compiled for, and the caller of that compiled function: the
+#: loop's steps call the right-hand side through its address (``ints[I_RHS_KERNEL]``), so
+#: that its code is compiled once, not again inside each function of the loop that calls it.
+RHS_SIGNATURE = _rhs_signature()
+_call_rhs = kernel_caller(RHS_SIGNATURE, "right-hand side")
 
 
 @intrinsic
@@ -540,7 +558,7 @@ def _initial_step(t, Y, G0, f0, parts, m, fs, ints):  # type: ignore[no-untyped-
     f1 = np.empty(n)
     aux = np.empty(aux_size_of(d))
     ints[I_RHS] += 1
-    status = rhs(t + h0, Yt, G0, parts, f1, aux, ints)
+    status = _call_rhs(ints[I_RHS_KERNEL], (t + h0, Yt, G0, parts, f1, aux, ints))
     if status != DONE:
         _fail(status, t + h0, fs, ints)
         return float(status)
@@ -583,7 +601,7 @@ def _start(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux)
     a fresh run, and the starting step when none is set. Returns the status."""
     t = fs[F_T]
     ints[I_RHS] += 1
-    status = rhs(t, Y, G0, parts, f0, aux, ints)
+    status = _call_rhs(ints[I_RHS_KERNEL], (t, Y, G0, parts, f0, aux, ints))
     if status != DONE:
         return _fail(status, t, fs, ints)
     ints[I_STARTED] = 1
@@ -644,7 +662,9 @@ def _extension(t, h, Y, Y1, K, G0, parts, m, fs, ints, F):  # type: ignore[no-un
     for i in range(first, n_ext):
         _stage_state(Y, h, m.A_ext[i], Kx, i, Yt)
         ints[I_RHS] += 1
-        status = rhs(t + m.c_ext[i] * h, Yt, G0, parts, Kx[i], tmp_aux, ints)
+        status = _call_rhs(
+            ints[I_RHS_KERNEL], (t + m.c_ext[i] * h, Yt, G0, parts, Kx[i], tmp_aux, ints)
+        )
         if status != DONE:
             return _fail(status, t + m.c_ext[i] * h, fs, ints)
     last = m.n_stages
@@ -683,7 +703,7 @@ def _extension_error(t, h, Y, F, G0, parts, m, fs, ints, sc):  # type: ignore[no
     ddy = np.empty(n)
     tmp_aux = np.empty(aux_size_of(parts.dims))
     ints[I_RHS] += 1
-    status = rhs(t + s_star * h, u, G0, parts, ddy, tmp_aux, ints)
+    status = _call_rhs(ints[I_RHS_KERNEL], (t + s_star * h, u, G0, parts, ddy, tmp_aux, ints))
     if status != DONE:
         return 0.0, _fail(status, t + s_star * h, fs, ints)
     acc2 = 0.0
@@ -807,7 +827,9 @@ def advance(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux
         for i in range(1, m.n_stages):
             _stage_state(Y, h_try, m.A[i], K, i, Yt)
             ints[I_RHS] += 1
-            status = rhs(t + m.c[i] * h_try, Yt, G0, parts, K[i], aux1, ints)
+            status = _call_rhs(
+                ints[I_RHS_KERNEL], (t + m.c[i] * h_try, Yt, G0, parts, K[i], aux1, ints)
+            )
             if status != DONE:
                 status = _fail(status, t + m.c[i] * h_try, fs, ints)
                 break
@@ -815,7 +837,9 @@ def advance(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux
             break
         _stage_state(Y, h_try, m.b, K, m.n_stages, Y1)
         ints[I_RHS] += 1
-        status = rhs(t + h_try, Y1, G0, parts, Yt, aux1, ints)  # Yt: f(t + h, y₁)
+        status = _call_rhs(
+            ints[I_RHS_KERNEL], (t + h_try, Y1, G0, parts, Yt, aux1, ints)
+        )  # Yt: f(t + h, y₁)
         if status != DONE:
             status = _fail(status, t + h_try, fs, ints)
             break
@@ -848,7 +872,7 @@ def advance(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux
                 tt = outs[out_i]
                 w = ints[I_WRITTEN]
                 _interpolate(F, Y, (tt - t) / h_try, bY[w])
-                status = rhs(tt, bY[w], G0, parts, Yt, baux[w], ints)
+                status = _call_rhs(ints[I_RHS_KERNEL], (tt, bY[w], G0, parts, Yt, baux[w], ints))
                 if status != DONE:
                     status = _fail(status, tt, fs, ints)
                     break
@@ -901,30 +925,34 @@ def signature(prog: Program | None = None) -> tuple[Any, ...]:
 
 
 def loaded(prog: Program | None = None) -> bool:
-    """Whether the loop is compiled in this process, loading it from numba's cache when it is
-    there; never compiles.
+    """Whether the loop (:func:`rhs` and :func:`advance`) is compiled in this process, loading
+    it from numba's cache when it is there; never compiles.
 
     This reads numba's dispatcher internals (its cache and overloads, numba 0.59–0.68);
     if they change, it answers False and the loop compiles on the next ``compile_loop``."""
     global _ready
-    if _ready:
-        return True
+    if not _ready:
+        _ready = _load(rhs, RHS_SIGNATURE) and _load(advance, signature(prog))
+    return _ready
+
+
+def _load(kernel: Any, sig: Any) -> bool:
+    """Whether ``kernel`` has its overload for ``sig`` in this process, loading it from numba's
+    cache if it is there (never compiling). ``sig`` is what the kernel was compiled with (a
+    signature or a tuple of argument types): numba's cache index is keyed by it."""
     from numba.core.compiler_lock import global_compiler_lock
 
-    sig = signature(prog)
+    args = tuple(getattr(sig, "args", sig))
     try:
         with global_compiler_lock:
-            if tuple(sig) not in advance.overloads:
-                cres = advance._cache.load_overload(sig, advance.targetctx)
+            if args not in kernel.overloads:
+                cres = kernel._cache.load_overload(sig, kernel.targetctx)
                 if cres is None:
                     return False
-                advance.targetctx.insert_user_function(
-                    cres.entry_point, cres.fndesc, [cres.library]
-                )
-                advance.add_overload(cres)
+                kernel.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+                kernel.add_overload(cres)
     except (AttributeError, TypeError):  # numba's internals moved
         return False
-    _ready = True
     return True
 
 
@@ -971,9 +999,17 @@ def compile_loop(*, announce: bool = True, timeout: float = 900.0) -> bool:
 
 
 def _compile_now() -> None:
+    rhs_address()
     advance.compile(signature())
     global _ready
     _ready = True
+
+
+@functools.cache
+def rhs_address() -> int:
+    """The address of :func:`rhs` compiled for :data:`RHS_SIGNATURE` (compiled, or loaded from
+    numba's cache, once per process): what the driver puts in ``ints[I_RHS_KERNEL]``."""
+    return kernel_address(rhs, RHS_SIGNATURE)
 
 
 def _lock_path() -> Path:
