@@ -46,7 +46,8 @@ def test_qr_solve_equals_the_svd_solve_within_the_conditioning(seed):
         assert np.abs(ac - ac_svd).max() <= 50 * EPS * kappa * np.abs(ac_svd).max()
         assert np.abs(lam - lam_svd).max() <= 50 * EPS * kappa**2 * np.abs(lam_svd).max()
         assert res <= 50 * EPS * kappa * max(np.abs(b).max(), np.abs(A @ a).max())
-        expected = max(1.0, np.linalg.norm(b), np.linalg.norm(A @ a))
+        # the scale-invariant consistency scale (issue #25, item 10): ‖b‖ + ‖A‖_F(‖a‖ + ‖ν̇_c‖)
+        expected = np.linalg.norm(b) + np.linalg.norm(A) * (np.linalg.norm(a) + np.linalg.norm(ac))
         assert abs(scale - expected) <= 1e-12 * expected
     assert declined <= 10  # the SVD is the exception, not the rule
 

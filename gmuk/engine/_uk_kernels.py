@@ -28,7 +28,8 @@ def uk_dense(
 ) -> tuple[np.ndarray, np.ndarray, int, float, float]:
     """Moore–Penrose UK solve through the SVD of B = A M^{-1/2} (McCann 2020, Eq. 64).
 
-    Returns (ν̇_c, λ, rank, ‖A(a + ν̇_c) − b‖₂, ‖A a‖₂).
+    Returns (ν̇_c, λ, rank, ‖A(a + ν̇_c) − b‖₂, scale), with the scale of the consistency
+    test of :func:`consistency_scale`.
     """
     Aa = A @ a
     r = b - Aa
@@ -46,7 +47,28 @@ def uk_dense(
     lam = Ur @ (c / sig[:rank])
     ac = Minv_sqrt @ y
     res = A @ (a + ac) - b
-    return ac, lam, rank, np.sqrt(np.sum(res * res)), np.sqrt(np.sum(Aa * Aa))
+    scale = consistency_scale(
+        np.sqrt(np.sum(b * b)),
+        np.sqrt(np.sum(A * A)),
+        np.sqrt(np.sum(a * a)),
+        np.sqrt(np.sum(ac * ac)),
+    )
+    return ac, lam, rank, np.sqrt(np.sum(res * res)), scale
+
+
+@njit(cache=True, inline="always")
+def consistency_scale(norm_b: float, norm_A: float, norm_a: float, norm_ac: float) -> float:
+    """The scale of the consistency test ``‖A(a + ν̇_c) − b‖₂ > tol · scale``:
+    ``‖b‖₂ + ‖A‖_F (‖a‖₂ + ‖ν̇_c‖₂)``, the size of the terms whose rounding the residual
+    holds (so the test is relative: rows and right-hand side scaled by any c > 0, the
+    decision is the same; contradictory rows scaled by 1e-8 are still inconsistent, and
+    consistent ones scaled by 1e-8 or 1e8 still consistent). It has no absolute floor: a
+    residual is compared with the size of the rows, never with 1.
+
+    The residual of a least-squares solution is at most ‖b − A a‖₂ ≤ scale, so the relative
+    residual of contradictory rows is of order one; with ``a = b = 0`` the solution and the
+    residual are exactly zero and the test passes."""
+    return norm_b + norm_A * (norm_a + norm_ac)
 
 
 @njit(cache=True)
@@ -72,8 +94,9 @@ def _qr_solve(
     for the SVD solve instead.
 
     Writes ν̇_c into ``ac`` (n,) and λ into ``lam`` (s,); returns (‖A(a + ν̇_c) − b‖₂,
-    max(1, ‖b‖₂, ‖A a‖₂), status): the second is the scale of the consistency test; status 0
-    solved, 1 use the SVD solve, 2 A or b not finite.
+    scale, status): the second is the scale of the consistency test
+    (:func:`consistency_scale`, ‖b‖₂ + ‖A‖_F (‖a‖₂ + ‖ν̇_c‖₂)); status 0 solved, 1 use the
+    SVD solve, 2 A or b not finite.
     """
     s, n = A.shape
     for i in range(s):
@@ -92,13 +115,11 @@ def _qr_solve(
             for k in range(n):
                 acc += Minv_sqrt[r, k] * A[i, k]
             X[r, i] = acc
-    Aa = np.empty(s)
     res = np.empty(s)
     for i in range(s):
         acc = 0.0
         for k in range(n):
             acc += A[i, k] * a[k]
-        Aa[i] = acc
         res[i] = b[i] - acc
     # Householder QR in place: reflectors v_k (stored below and on the diagonal of X),
     # beta_k = 2 / vᵀv, R's diagonal in d.
@@ -172,16 +193,22 @@ def _qr_solve(
             acc += Minv_sqrt[r, k] * z[k]
         ac[r] = acc
     rr = 0.0
-    na = 0.0
+    nA = 0.0
     nb = 0.0
     for i in range(s):
         acc = -res[i]
         for k in range(n):
             acc += A[i, k] * ac[k]
+            nA += A[i, k] * A[i, k]
         rr += acc * acc
-        na += Aa[i] * Aa[i]
         nb += b[i] * b[i]
-    return np.sqrt(rr), max(1.0, np.sqrt(nb), np.sqrt(na)), 0
+    na = 0.0
+    nac = 0.0
+    for k in range(n):
+        na += a[k] * a[k]
+        nac += ac[k] * ac[k]
+    scale = consistency_scale(np.sqrt(nb), np.sqrt(nA), np.sqrt(na), np.sqrt(nac))
+    return np.sqrt(rr), scale, 0
 
 
 @njit(cache=True)

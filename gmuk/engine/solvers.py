@@ -102,6 +102,12 @@ def _fused_entry() -> Any:
     return _uk_rigid_c
 
 
+def _frobenius(A: Any) -> float:
+    """‖A‖_F of a dense or sparse matrix."""
+    values = A.data if sp.issparse(A) else A
+    return float(np.sqrt(np.sum(np.square(values))))
+
+
 def _writable(x: FloatArray) -> FloatArray:
     """``x``, or a copy of it when it is read-only (same values, same C layout): the compiled
     entry takes writable arrays only, the loop's types."""
@@ -266,11 +272,20 @@ class UKSolver(abc.ABC):
         """The constraint acceleration for free acceleration ``a`` (n_dof,) at ``state``.
 
         ``rows`` are the stacked (A, b) when the caller has them already. Returns
-        (ν̇_c (n_dof,), λ (s,), rank or None, residual, unreachable).
+        (ν̇_c (n_dof,), λ (s,), rank or None, residual, unreachable). Strategies on R⁶ rows
+        call :meth:`check_consistency`, whose test is scale-invariant (relative to ‖b‖ and
+        ‖A‖ times the accelerations).
         """
 
     def check_consistency(self, state: State, residual: float, scale: float) -> None:
-        """Warn (raise in strict mode) when ‖A ν̇ − b‖ exceeds consistency_tol × scale."""
+        """Warn (raise in strict mode) when ‖A ν̇ − b‖ exceeds consistency_tol × scale.
+
+        The test is relative to the size of the rows: ``scale`` is
+        ``‖b‖₂ + ‖A‖_F (‖ν̇_a‖₂ + ‖ν̇_c‖₂)`` (:func:`gmuk.engine._uk_kernels.consistency_scale`,
+        computed by the solve kernels, the same in the compiled loop), with no absolute floor.
+        Scaling every row and its right-hand side by any c > 0 leaves the decision as it is:
+        contradictory rows scaled by 1e-8 still warn, consistent rows scaled by 1e-8 or 1e8
+        do not."""
         system = self.system
         if residual > system.consistency_tol * scale:
             msg = (
@@ -355,7 +370,12 @@ class DenseSolver(UKSolver):
     def solve_rows(
         self, state: State, a: FloatArray, A: FloatArray, b: FloatArray
     ) -> tuple[FloatArray, FloatArray, int | None, float]:
-        """UK solve of given dense rows, with the consistency check."""
+        """UK solve of given dense rows, with the consistency check.
+
+        Inconsistent means ``‖A(a + ν̇_c) − b‖₂ > consistency_tol · (‖b‖₂ + ‖A‖_F (‖a‖₂ +
+        ‖ν̇_c‖₂))`` (:meth:`check_consistency`): a relative test, the same in the QR and the
+        SVD solve and in the compiled loop's gate (which compares the QR kernel's residual
+        with ``consistency_tol`` times the scale the kernel returns)."""
         if b.size == 0:
             return np.zeros_like(a), np.zeros(0), 0, 0.0
         rcond = self.system.rcond
@@ -368,8 +388,8 @@ class DenseSolver(UKSolver):
             if status == _SOLVED:
                 self.check_consistency(state, residual, scale)
                 return ac, lam, b.size, residual
-        ac, lam, rank, residual, norm_Aa = _uk_kernels.uk_dense(A, b, a, self._Minv_sqrt, rcond)
-        self.check_consistency(state, residual, max(1.0, float(np.linalg.norm(b)), norm_Aa))
+        ac, lam, rank, residual, scale = _uk_kernels.uk_dense(A, b, a, self._Minv_sqrt, rcond)
+        self.check_consistency(state, residual, scale)
         return ac, lam, rank, residual
 
 
@@ -485,7 +505,11 @@ class SparseSolver(UKSolver):
             sp.csr_matrix(A), b - Aa, system._Minv_sp, system._Minv_sqrt_sp, self.method
         )
         residual = float(np.linalg.norm(A @ (a + ac) - b))
-        scale = max(1.0, float(np.sqrt(b @ b)), float(np.linalg.norm(Aa)))
+        scale = float(
+            _uk_kernels.consistency_scale(
+                np.sqrt(b @ b), _frobenius(A), np.linalg.norm(a), np.linalg.norm(ac)
+            )
+        )
         self.check_consistency(state, residual, scale)
         return ac, lam, rank, residual, 0.0
 

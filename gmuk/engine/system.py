@@ -86,7 +86,9 @@ class System:
         Raise :class:`gmuk.errors.InconsistentConstraintsError` on inconsistent constraints
         instead of warning.
     consistency_tol : float
-        Constraints count as inconsistent when ‖A ν̇ − b‖ > tol · max(1, ‖b‖, ‖A ν̇_a‖).
+        Constraints count as inconsistent when ‖A ν̇ − b‖₂ > tol · (‖b‖₂ + ‖A‖_F (‖ν̇_a‖₂ +
+        ‖ν̇_c‖₂)): relative to the size of the rows, so scaling them (and b) by any factor
+        does not change the decision.
     rcond : float, optional
         Relative singular-value cut-off for the rank of A M^{-1/2} (dense solves).
 
