@@ -4,6 +4,12 @@ A :class:`State` is an immutable snapshot: time, the poses and twists of the rig
 the positions and velocities of the Euclidean bodies (point masses and slack coordinates),
 and the controllers' internal states. A :class:`Layout` (made once by the System) says where
 each body's numbers are. Nothing here is mutated by the System or the integrator.
+
+A State's arrays are read-only (``flags.writeable`` is False), and they are its own: a
+part (force model, constraint, controller) that writes into the state it is given fails
+with numpy's ``ValueError: assignment destination is read-only`` (the run names the part),
+and the arrays a caller passed in are copied, never frozen or shared, so the caller's
+data cannot change behind its back either.
 """
 
 from __future__ import annotations
@@ -23,6 +29,25 @@ if TYPE_CHECKING:
 __all__ = ["Layout", "State"]
 
 BodyRef = Union["Body", str]
+
+_F64 = np.dtype(np.float64)
+_ARRAYS = ("g", "V", "x", "xdot", "z")
+
+
+def _frozen(a: np.ndarray) -> bool:
+    """Whether no one can write ``a``'s values: it and every array it views are read-only.
+
+    (An array owning its data could be made writable again by whoever holds it; the engine
+    and the State never do that.)"""
+    while True:
+        if a.flags.writeable:
+            return False
+        base = a.base
+        if base is None:
+            return True
+        if type(base) is not np.ndarray:  # a buffer (bytes, mmap, ...): copy to be sure
+            return False
+        a = base
 
 
 @dataclass(frozen=True)
@@ -132,6 +157,13 @@ class State:
         Controllers' internal states.
     layout : Layout
         Index of the bodies.
+
+    Notes
+    -----
+    The arrays are read-only float64 arrays owned by the State (or shared with another
+    State): the constructor copies any array that someone could still write, so neither a
+    part that is handed the State nor the caller who built it can change it afterwards.
+    The accessors return read-only views.
     """
 
     t: float
@@ -141,6 +173,39 @@ class State:
     xdot: FloatArray
     z: FloatArray
     layout: Layout
+
+    def __post_init__(self) -> None:
+        # Read-only arrays of its own: a copy of each array unless it is already read-only
+        # all the way down (another State's, or one this module froze), which is shared.
+        for name in _ARRAYS:
+            a = getattr(self, name)
+            if not (type(a) is np.ndarray and a.dtype == _F64 and _frozen(a)):
+                a = np.array(a, dtype=np.float64)
+                a.setflags(write=False)
+                object.__setattr__(self, name, a)
+
+    @classmethod
+    def _adopt(
+        cls,
+        t: float,
+        g: FloatArray,
+        V: FloatArray,
+        x: FloatArray,
+        xdot: FloatArray,
+        z: FloatArray,
+        layout: Layout,
+    ) -> State:
+        """A State that takes over fresh float64 arrays no one else holds (they are made
+        read-only here, not copied or checked): for the engine's own copies, which it hands
+        over. Cheaper than the constructor (the compiled loop's callback makes one per call)."""
+        g.setflags(write=False)
+        V.setflags(write=False)
+        x.setflags(write=False)
+        xdot.setflags(write=False)
+        z.setflags(write=False)
+        obj = object.__new__(cls)
+        obj.__dict__.update(t=t, g=g, V=V, x=x, xdot=xdot, z=z, layout=layout)
+        return obj
 
     def pose(self, body: BodyRef) -> FloatArray:
         """Pose g_NB (4, 4) of a rigid body."""

@@ -433,21 +433,24 @@ class System:
         else:
             zz = as_array(np.reshape(z, -1), (lay.n_control,), "z", batch=False)
         tt = real_number(t, "t")
-        state = State(tt, G, Vs, x, xd, zz, lay)
+        state = State._adopt(tt, G, Vs, x, xd, np.array(zz, dtype=float), lay)
         if self._owned_names:
-            self._set_owned(state)
+            state = self._set_owned(state)
         return state
 
-    def _set_owned(self, state: State) -> None:
-        """Fill in the bodies the constraints own (slack coordinates) from the others."""
+    def _set_owned(self, state: State) -> State:
+        """``state`` with the bodies the constraints own (slack coordinates) filled in from
+        the others (a new State: a State's arrays are read-only)."""
         free = self._free(state, self._generalized_forces(state)[0])
+        x, xd = state.x.copy(), state.xdot.copy()
         for c, cols in zip(self.constraints, self._constraint_cols, strict=True):
             if not c.owned_bodies:
                 continue
             values = c.initial_owned_state(state, free[cols])
             for body, (w, w_dot) in zip(c.owned_bodies, values, strict=True):
                 i = self.layout.slot(body).index
-                state.x[i], state.xdot[i] = w, w_dot
+                x[i], xd[i] = w, w_dot
+        return state.replace(x=x, xdot=xd)
 
     # ------------------------------------------------------------------ dynamics
     def _apply_Minv(self, Q: FloatArray) -> FloatArray:
@@ -509,27 +512,46 @@ class System:
         self, plan: list[Any], state: State, modeled: FloatArray, unmodeled: FloatArray
     ) -> None:
         """Add the generalized forces of the force models of ``plan`` (entries of
-        ``_force_plan``) at ``state`` to ``modeled`` and ``unmodeled`` (n_dof,)."""
+        ``_force_plan``) at ``state`` to ``modeled`` and ``unmodeled`` (n_dof,).
+
+        Each model's return values are checked (:func:`_part_output`): arrays of real numbers
+        (not booleans, complex numbers, strings or objects) of exactly the body's dof, and,
+        once per model, finite. Raises DefinitionError or NonFiniteError naming the model,
+        the body and the time."""
         t = state.t
         for f, bodies, slots in plan:
             target = modeled if f.modeled else unmodeled
-            if slots is None:
-                for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
-                    self._add(target, body, w, f"force {f.name!r}")
-                continue
-            for body, rigid, i, offset, dof in slots:
-                if rigid:
-                    w = f.wrench(t, state.g[i], state.V[i], body)
+            who = f"force {f.name!r}"
+            try:
+                if slots is None:
+                    for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
+                        self._add(target, body, w, who, t)
                 else:
-                    w = f.force(t, state.x[i : i + dof], state.xdot[i : i + dof], body)
-                if type(w) is not np.ndarray or w.shape != (dof,) or w.dtype != np.float64:
-                    w = np.asarray(w, dtype=float)
-                    if w.shape != (dof,):
-                        raise DefinitionError(
-                            f"force {f.name!r} returned shape {w.shape} for {body.kind} body "
-                            f"{body.name!r}; expected ({dof},)"
-                        )
-                target[offset : offset + dof] += w
+                    for body, rigid, i, offset, dof in slots:
+                        if rigid:
+                            w = f.wrench(t, state.g[i], state.V[i], body)
+                        else:
+                            w = f.force(t, state.x[i : i + dof], state.xdot[i : i + dof], body)
+                        if type(w) is not np.ndarray or w.shape != (dof,) or w.dtype != np.float64:
+                            w = _part_output(w, (dof,), who, body, t)
+                        target[offset : offset + dof] += w
+            except ValueError as exc:
+                _raise_if_read_only(exc, who, t)
+                raise
+            if not all_finite(target):  # once per model: it added NaN or inf
+                self._not_finite(target, bodies, who, t)
+
+    def _not_finite(self, target: FloatArray, bodies: Iterable[Body], who: str, t: float) -> None:
+        """Raise NonFiniteError naming the first of ``bodies`` whose entries of ``target``
+        (n_dof,) are not finite (the load a part just added)."""
+        for body in bodies:
+            s = self.layout.slot(body)
+            if not all_finite(target[s.offset : s.offset + s.dof]):
+                raise NonFiniteError(
+                    f"{who} returned a non-finite load (NaN or inf) for {body.kind} body "
+                    f"{body.name!r} at t = {t:.9g} s (or loads whose sum is beyond float64)"
+                )
+        raise NonFiniteError(f"{who} returned a non-finite load (NaN or inf) at t = {t:.9g} s")
 
     def _force_slot(self, body: Body) -> tuple[Body, bool, int, int, int]:
         s = self.layout.slot(body)
@@ -545,28 +567,60 @@ class System:
     def _controls_of(
         self, which: Iterable[int], state: State, modeled: FloatArray
     ) -> tuple[FloatArray, FloatArray]:
-        """:meth:`_controls` of the controllers numbered ``which`` only (ż zero elsewhere)."""
+        """:meth:`_controls` of the controllers numbered ``which`` only (ż zero elsewhere).
+
+        Each controller's return values are checked: one wrench per body as in
+        :meth:`_add_loads`, and ż an array of real numbers with exactly ``n_states`` entries
+        (a scalar or another length is not broadcast), finite. Raises DefinitionError or
+        NonFiniteError naming the controller (and the body) and the time."""
         control = np.zeros(self.layout.n_dof)
         z_dot = np.zeros(self.layout.n_control)
         modeled.setflags(write=False)
+        t = state.t
         for k in which:
             c, bodies, sl = self.controllers[k], self._ctrl_bodies[k], self._ctrl_slices[k]
-            if c.uses_modeled_acceleration:
-                u, zd = c.control(state, state.z[sl], modeled)
-            else:
-                u, zd = c.control(state, state.z[sl])
-            for body, w in zip(bodies, u, strict=True):
-                self._add(control, body, np.asarray(w, dtype=float), f"controller {c.name!r}")
-            z_dot[sl] = np.asarray(zd, dtype=float).reshape(-1)
+            who = f"controller {c.name!r}"
+            try:
+                if c.uses_modeled_acceleration:
+                    out = c.control(state, state.z[sl], modeled)
+                else:
+                    out = c.control(state, state.z[sl])
+            except ValueError as exc:
+                _raise_if_read_only(exc, who, t)
+                raise
+            if not (isinstance(out, (tuple, list)) and len(out) == 2):
+                raise DefinitionError(
+                    f"{who}: control() must return a pair (u, z_dot); got "
+                    f"{type(out).__name__} {out!r:.60}"
+                )
+            u, zd = out
+            try:
+                pairs = list(zip(bodies, u, strict=True))
+            except (TypeError, ValueError):
+                raise DefinitionError(
+                    f"{who}: control() must return one load per body ({len(bodies)}) as a "
+                    f"sequence; got {type(u).__name__} {u!r:.60}"
+                ) from None
+            for body, w in pairs:
+                self._add(control, body, w, who, t)
+            n = sl.stop - sl.start
+            if type(zd) is not np.ndarray or zd.shape != (n,) or zd.dtype != np.float64:
+                zd = _part_output(zd, (n,), who, None, t)
+            z_dot[sl] = zd
+            if not all_finite(control):
+                self._not_finite(control, bodies, who, t)
+            if not all_finite(zd):
+                raise NonFiniteError(
+                    f"{who} returned a non-finite z_dot (NaN or inf) at t = {t:.9g} s: {zd!r:.80}"
+                )
         return control, z_dot
 
-    def _add(self, target: FloatArray, body: Body, w: FloatArray, who: str) -> None:
+    def _add(self, target: FloatArray, body: Body, w: Any, who: str, t: float) -> None:
+        """Add a part's load ``w`` for ``body`` into ``target`` (n_dof,), checked as
+        :func:`_part_output` checks it (finiteness is the caller's, once per part)."""
         s = self.layout.slot(body)
-        if w.shape != (s.dof,):
-            raise DefinitionError(
-                f"{who} returned shape {w.shape} for {body.kind} body "
-                f"{body.name!r}; expected ({s.dof},)"
-            )
+        if type(w) is not np.ndarray or w.shape != (s.dof,) or w.dtype != np.float64:
+            w = _part_output(w, (s.dof,), who, body, t)
         target[s.offset : s.offset + s.dof] += w
 
     def constraint_rows(self, state: State) -> tuple[FloatArray | sp.csr_matrix, FloatArray]:
@@ -806,14 +860,92 @@ class System:
         )
 
 
+def _part_output(
+    w: Any, shape: tuple[int, ...], who: str, body: Body | None, t: float
+) -> FloatArray:
+    """A part's return value ``w`` as a float64 array of ``shape``, refusing what is not an
+    array of real numbers (booleans, complex numbers, strings, objects: dtype kinds other
+    than f, i, u) and a load of another shape. ``body`` None: ``w`` is a controller's ż,
+    which may have any shape with exactly ``shape[0]`` entries (never broadcast).
+
+    The slow path of the System's checks: a float64 ndarray of ``shape`` never comes here.
+    Finiteness is checked by the caller, once per part.
+    """
+    what = f"for {body.kind} body {body.name!r}" if body is not None else "as z_dot"
+    arr: Any = None
+    if not isinstance(w, (bool, np.bool_, str, bytes, complex)):
+        try:
+            arr = np.asarray(w)
+        except (TypeError, ValueError):  # ragged sequences
+            arr = None
+    if arr is None or arr.dtype.kind not in "fiu":
+        got = f"{type(w).__name__}" if arr is None else f"dtype {arr.dtype}"
+        raise DefinitionError(
+            f"{who} returned {got} {w!r:.60} {what} at t = {t:.9g} s; expected an array of "
+            f"real numbers (float or int; not bool, complex or str) of shape {shape}"
+        )
+    if arr.shape != shape and not (body is None and arr.size == shape[0]):
+        expected = f"{shape[0]} entries" if body is None else f"shape {shape}"
+        raise DefinitionError(
+            f"{who} returned shape {arr.shape} {what} at t = {t:.9g} s; expected {expected}"
+        )
+    return arr.astype(np.float64).reshape(shape)
+
+
 def _pair(c: Constraint, state: State) -> tuple[Any, Any]:
-    """A constraint's ``rows(state)``, checked to be a pair (A, b)."""
-    out = c.rows(state)
+    """A constraint's ``rows(state)``, checked to be a pair (A, b); A and b that are not
+    float64 ndarrays must hold real numbers of kinds f, i, u (booleans are refused here;
+    complex numbers, strings and objects by ``as_rows``)."""
+    try:
+        out = c.rows(state)
+    except ValueError as exc:
+        _raise_if_read_only(exc, f"constraint {c.name!r}", state.t)
+        raise
     if type(out) is tuple and len(out) == 2:
-        return out
-    if isinstance(out, (tuple, list)) and len(out) == 2:
-        return out[0], out[1]
+        A, b = out
+    elif isinstance(out, (tuple, list)) and len(out) == 2:
+        A, b = out[0], out[1]
+    else:
+        A = b = None
+    if A is not None:
+        if not (type(A) is np.ndarray and A.dtype == np.float64):
+            _not_bool(A, c, state, "A")
+        if not (type(b) is np.ndarray and b.dtype == np.float64):
+            _not_bool(b, c, state, "b")
+        return A, b
     raise ConstraintError(
         f"constraint {c.name!r}: rows() must return a pair (A, b); got {type(out).__name__}"
         + (f" of length {len(out)}" if isinstance(out, (tuple, list)) else f" {out!r:.60}")
     )
+
+
+def _not_bool(x: Any, c: Constraint, state: State, name: str) -> None:
+    """Refuse booleans as a constraint's A or b (numpy would read True as 1.0)."""
+    dtype = getattr(x, "dtype", None)
+    if dtype is None:
+        if isinstance(x, (bool, np.bool_)):
+            kind = "b"
+        else:
+            try:
+                kind = np.asarray(x).dtype.kind
+            except (TypeError, ValueError):
+                return  # as_rows names what is wrong
+    else:
+        kind = np.dtype(dtype).kind
+    if kind == "b":
+        raise ConstraintError(
+            f"constraint {c.name!r}: rows() returned booleans as {name} at t = {state.t:.9g} s; "
+            "expected real numbers (float or int)"
+        )
+
+
+def _raise_if_read_only(exc: ValueError, who: str, t: float) -> None:
+    """Raise a DefinitionError naming the part when ``exc`` is numpy's refusal to write into
+    a read-only array: the part wrote into the State (or the modeled acceleration) it was
+    given, which are read-only so that no part can change the caller's data."""
+    if "read-only" in str(exc):
+        raise DefinitionError(
+            f"{who} tried to write into the arrays it was given at t = {t:.9g} s ({exc}): a "
+            "State and the modeled acceleration are read-only; copy them "
+            "(e.g. state.V.copy()) to compute in place"
+        ) from exc

@@ -517,7 +517,7 @@ class PythonParts:
         from gmuk.constraints.base import as_rows
         from gmuk.state import State as _State
 
-        self._as_rows, self._make_state, self._pair = as_rows, _State, view.rows_of
+        self._as_rows, self._make_state, self._pair = as_rows, _State._adopt, view.rows_of
         self._c_function = _CALLBACK_TYPE(self._call)  # kept alive with the program
         self.address = int(ctypes.cast(self._c_function, ctypes.c_void_p).value or 0)
 
@@ -535,7 +535,8 @@ class PythonParts:
         return 0
 
     def state(self) -> State:
-        """The state the loop wrote into ``io``."""
+        """The state the loop wrote into ``io``: copies, read-only (:meth:`State._adopt`),
+        so a part that writes into it fails instead of changing the loop's state."""
         io, lay = self.io, self.layout
         return self._make_state(
             float(io[0]),
