@@ -196,6 +196,29 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
             In SI units of acceleration (rad/s², m/s², …) times those of A.
         """
 
+    def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
+        """How far ``state`` is off this constraint: the residuals its rows hold at zero.
+
+        :func:`gmuk.engine.integrate.simulate` evaluates them at the output times of a run to
+        check that the constraint did not drift (``drift_tol``; docs/reliability.rst,
+        "Constraint drift").
+
+        Returns
+        -------
+        position : ndarray (p,) or None
+            The position-level residual (e.g. φ(q, t), or log(g_d⁻¹ g)), in the residual's
+            own units; None when the constraint states none.
+        velocity : ndarray (q,) or None
+            The velocity-level residual (e.g. φ̇, ψ(q, ν, t), or a twist error); None when
+            the constraint states none.
+
+        A residual on an orbital scale may be weighed as the integrator weighs the state
+        (translations against the distance, rotations in rad): the tracking constraints do.
+        The default, (None, None), is for a constraint given only by its acceleration rows:
+        the drift check passes over it. Subclasses that hold a residual at zero override it.
+        """
+        return None, None
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}(bodies={list(self.body_names)}, name={self.name!r})"
 

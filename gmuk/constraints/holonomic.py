@@ -255,6 +255,12 @@ class HolonomicConstraint(_Differentiable):
     def _path_derivatives(self, q: Config, nu: Config, t: float) -> tuple[FloatArray, FloatArray]:
         return self._path_fd(lambda qq, tt: self.residual(qq, tt), q, nu, t)
 
+    def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
+        """(φ(q, t), φ̇) at ``state`` (:meth:`Constraint.violation`)."""
+        q, nu, _ = body_configs(state, self.bodies)
+        phi = np.asarray(self.residual(q, state.t), dtype=float).reshape(-1)
+        return phi, np.asarray(self.rate(q, nu, state.t), dtype=float).reshape(-1)
+
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) at ``state``, with Baumgarte terms when gains are set."""
         q, nu, _ = body_configs(state, self.bodies)
@@ -295,6 +301,11 @@ class NonholonomicConstraint(_Differentiable):
     def bias(self, q: Config, nu: Config, t: float) -> FloatArray:
         """b = −(d/dτ) ψ(q ⊕ τν, ν, t + τ) at τ = 0, shape (s,). Override for speed."""
         return self._velocity_bias_fd(self.residual, q, nu, t)
+
+    def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
+        """(None, ψ(q, ν, t)) at ``state`` (:meth:`Constraint.violation`)."""
+        q, nu, _ = body_configs(state, self.bodies)
+        return None, np.asarray(self.residual(q, nu, state.t), dtype=float).reshape(-1)
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) at ``state``, with the Baumgarte term when a gain is set."""

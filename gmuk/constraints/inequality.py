@@ -337,6 +337,32 @@ class InequalityConstraint(_Differentiable):
                     b[i] -= alpha * (h - bd.value + bd.sign * w_dot * w_dot)
         return A, b
 
+    def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
+        """The residuals of the equalities ``h − bound + σw² = 0``, one per bound
+        (:meth:`Constraint.violation`): at the position level (φ, φ̇); at the velocity level
+        (None, h − bound + σẇ²). Each is divided by max(1, |bound| + the size of h's own terms,
+        e.g. a TrackingErrorBound's bound) (in the unit of h): the
+        equality balances quantities of the bound's size, and its finite-difference rows
+        carry noise in proportion (a position bound of 1000 m on an orbit holds its
+        equality to 1e-5 m under Baumgarte terms, 1e-8 of the bound)."""
+        q, nu = self._configs(state)
+        t = state.t
+        h = self._value(q, nu, t)
+        idx = self._slack_indices(state)
+        w = np.array([float(state.x[j]) for j in idx])
+        w_dot = np.array([float(state.xdot[j]) for j in idx])
+        sign = np.array([bd.sign for bd in self._bounds], dtype=float)
+        value = np.array([bd.value for bd in self._bounds], dtype=float)
+        scale = np.maximum(1.0, np.abs(value) + self._violation_scale(t))
+        if self.level == "position":
+            h_dot = self._scalar(self.rate(q, nu, t), "rate()")
+            return (h - value + sign * w * w) / scale, (h_dot + 2.0 * sign * w * w_dot) / scale
+        return None, (h - value + sign * w_dot * w_dot) / scale
+
+    def _violation_scale(self, t: float) -> float:
+        """A size of h at time t beyond the bounds (0 here), to weigh :meth:`violation`."""
+        return 0.0
+
     # ------------------------------------------------------------------ initial slack
     def initial_slack(
         self, state: State, free_acceleration: FloatArray
@@ -650,6 +676,11 @@ class TrackingErrorBound(InequalityConstraint):
                 f"the reference, or use form='squared'"
             )
         return n
+
+    def _violation_scale(self, t: float) -> float:
+        """The bound (norm form) or ½ bound² (squared form): h is a difference of these."""
+        d = abs(float(self.bound(float(t))[0]))
+        return d if self.form == "norm" else 0.5 * d * d
 
     def value(self, q: Config, nu: Config, t: float) -> float:
         """‖error‖ − bound, or ½(‖error‖² − bound²) for the squared form."""

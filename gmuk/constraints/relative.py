@@ -246,6 +246,25 @@ class RelativeConstraint(Constraint):
             return None
         return [*self._alpha, *self.S.ravel()], self.S.shape[0]
 
+    def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
+        """(None, S (V_{B/L} − v_des)) (:meth:`Constraint.violation`), v_des = ``velocity(t)``
+        if given, else zero; (None, None) when an ``acceleration`` is prescribed without its
+        ``velocity`` (the relative twist it leads to is not known). The relative pose is not
+        constrained: only its accelerations are."""
+        if self.acceleration is not None and self.velocity is None:
+            return None, None
+        iL, iB = self._rigid_indices(state)
+        _, V_BL, _ = relative_twist(state.g[iL], state.V[iL], state.g[iB], state.V[iB])
+        if self.velocity is not None:
+            v_des = np.asarray(self.velocity(state.t), dtype=np.float64)
+            if v_des.shape != (6,):
+                raise ConstraintError(
+                    f"constraint {self.name!r}: velocity(t) returned shape {v_des.shape}; "
+                    "expected (6,)"
+                )
+            V_BL = V_BL - v_des
+        return None, self.S @ V_BL
+
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """(A, b) with columns [V_L, V_B]."""
         iL, iB = self._rigid_indices(state)

@@ -93,6 +93,15 @@ class ConfigurationTrackingT2(TangentBundleConstraint):
             )
         self.reference = reference
 
+    def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
+        """(e_g, e_V) against the reference, weighed as for
+        :meth:`gmuk.constraints.ConfigurationTracking.violation`."""
+        from gmuk.constraints.tracking import relative_errors
+
+        (i,) = self._rigid_indices(state)
+        ref = self.reference.evaluate(state.t)
+        return relative_errors(state.g[i], state.V[i], ref.g, ref.V)
+
     def tangent_rows(self, state: State) -> tuple[FloatArray, FloatArray, FloatArray]:
         """A = B = I₄ and C = g̈_d."""
         ref = self.reference.evaluate(state.t)
@@ -153,6 +162,25 @@ class VirtualPairT2(TangentBundleConstraint):
                 f"reference must be a gmuk.ReferenceTrajectory; got {type(reference).__name__}"
             )
         self.reference = reference
+
+    def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
+        """L's tracking errors (e_g, e_V) against the reference followed by the five locked
+        components of B relative to L: ``log(g_L⁻¹ g_B)`` and ``V_{B/L}`` without their roll
+        (first) component (:meth:`Constraint.violation`); translations weighed as in
+        :meth:`gmuk.constraints.ConfigurationTracking.violation` (against max(1 m, ‖r_d‖)
+        and max(1 m/s, ‖v_d‖))."""
+        from gmuk.constraints.tracking import relative_errors
+
+        L, Bd = self.bodies
+        g_L, V_L, g_B, V_B = state.pose(L), state.twist(L), state.pose(Bd), state.twist(Bd)
+        ref = self.reference.evaluate(state.t)
+        e_g, e_V = relative_errors(g_L, V_L, ref.g, ref.V)
+        h = se3._inverse(g_L) @ g_B
+        V_rel = V_B - se3._Ad(se3._inverse(h)) @ V_L
+        log_h = se3.log(h)
+        log_h[3:] /= max(1.0, float(np.linalg.norm(ref.g[:3, 3])))
+        V_rel[3:] /= max(1.0, float(np.linalg.norm(ref.V[3:])))
+        return np.concatenate([e_g, log_h[1:]]), np.concatenate([e_V, V_rel[1:]])
 
     def tangent_rows(self, state: State) -> tuple[FloatArray, FloatArray, FloatArray]:
         """(A (7, 8), B (8, 6), C (7, 6)) for [L, B]."""
