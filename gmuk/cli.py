@@ -25,6 +25,12 @@ into ``DIR/.checkpoints`` every ``--checkpoint-every`` seconds (default 60), so 
 process (SIGKILL, a power cut) loses at most one interval; ``gmuk run --resume DIR`` continues
 the run with the options it was started with. A run that completes removes its checkpoints.
 
+Constraint drift (:func:`gmuk.engine.integrate.simulate`, ``drift_tol``): ``summary.json``
+gives each run's ``constraint_violation`` (largest position- and velocity-level residuals,
+tolerance, one entry per constraint) and ``drifted``; a run that completed with a constraint
+drifted past its tolerance has ``status`` "drifted" (``runs_drifted`` names the runs), prints
+why on stderr, and exits with status 3 after writing everything.
+
 One run at a time owns an output folder: ``gmuk run`` (and ``--resume``) holds a lock on
 ``DIR/.gmuk-lock`` (:mod:`gmuk._locks`; the file names the process, host and start time) for
 as long as it runs. A second run into the same folder is refused at once with a
@@ -177,6 +183,9 @@ def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
 
 #: Exit status of a run stopped by a signal: 128 + the signal's number, as shells report it.
 EXIT_STATUS = {signal.SIGINT: 130, signal.SIGTERM: 143}
+#: Exit status of a ``gmuk run`` that completed with a constraint drifted past its tolerance
+#: (status "drifted": the files are written, the results are not on their constraint).
+EXIT_DRIFTED = 3
 
 
 @contextmanager
@@ -309,15 +318,27 @@ def _run_owned(
             result = scenario.run(**options)
     elapsed = time.perf_counter() - t0
     primary = result.trajectories[result.primary]
-    stopped = [k for k, v in result.trajectories.items() if v.status != "success"]
+    stopped = [k for k, v in result.trajectories.items() if v.status not in ("success", "drifted")]
+    # completed runs whose constraint drifted past simulate's drift_tol
+    drifted = [k for k, v in result.trajectories.items() if v.status == "drifted"]
     path = primary.save(out / "trajectory.npz")
+    status = primary.status
+    if status == "success":
+        status = "partial" if stopped else "drifted" if drifted else "success"
     summary = {
         "scenario": result.name,
-        "status": primary.status if primary.status != "success" or not stopped else "partial",
+        "status": status,
         "message": primary.message,
         "t_reached_s": float(primary.t[-1]) if len(primary.t) else None,
         **({"signal": signal.Signals(received[0]).name} if received else {}),
         **({"runs_not_completed": stopped} if stopped else {}),
+        "drifted": bool(drifted),
+        **({"runs_drifted": drifted} if drifted else {}),
+        "constraint_violation": {
+            k: v.stats["constraint_violation"]
+            for k, v in result.trajectories.items()
+            if "constraint_violation" in v.stats
+        },
         "options": {k: list(v) if isinstance(v, tuple) else v for k, v in options.items()},
         **({"orbits": options["orbits"]} if "orbits" in options else {}),
         "wall_time_s": elapsed,
@@ -351,11 +372,23 @@ def _run_owned(
         )
         return EXIT_STATUS[signal.Signals(received[0])]
     shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)
-    print(f"{result.name}{f' ({shown})' if shown else ''}: {elapsed:.2f} s")
+    print(f"{result.name}{f' ({shown})' if shown else ''}: {elapsed:.2f} s, status {status}")
     for key, value in result.summary.items():
         print(f"  {key}: {value:.6g}" if isinstance(value, float) else f"  {key}: {value}")
+    for key, check in summary["constraint_violation"].items():
+        worst = ", ".join(
+            f"{level} {check[level]:.3g}"
+            for level in ("position", "velocity")
+            if check[level] is not None
+        )
+        tol = "not judged" if check["tolerance"] is None else f"drift_tol {check['tolerance']:g}"
+        print(f"  constraint violation ({key}): {worst or 'none stated'} ({tol})")
     data = f", {len(extra)} further data file(s)" if extra else ""
     print(f"wrote {path}, {out / 'summary.json'}{data} and {len(figures)} figure file(s) in {out}")
+    if drifted:
+        for k in drifted:
+            print(f"{result.name}: run {k!r}: {result.trajectories[k].message}", file=sys.stderr)
+        return EXIT_DRIFTED
     return 0
 
 
@@ -479,7 +512,7 @@ def _write_run_view(primary: Any, out: Path, scenario: Scenario) -> Path:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``gmuk`` console script; returns the exit status (0 success, 1
-    ``gmuk check`` found a disagreement, 2 bad input)."""
+    ``gmuk check`` found a disagreement, 2 bad input, 3 a run's constraint drifted)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         if argv[:1] == ["run"]:

@@ -81,10 +81,15 @@ class Trajectory:
         Rank of A (−1 where not computed).
     body_names, body_kinds : tuple of str
     body_dofs : tuple of int
-    status : {"success", "interrupted", "failed"}
+    status : {"success", "drifted", "interrupted", "failed"}
+        "drifted": the run completed its span but a constraint drifted off past
+        ``drift_tol`` (:func:`gmuk.engine.integrate.simulate`); the message says which and when.
     message : str
     stats : dict
-        ``n_rhs`` (right-hand-side evaluations), ``n_steps``, ``n_rejected``, ``method``.
+        ``n_rhs`` (right-hand-side evaluations), ``n_steps``, ``n_rejected``, ``method``;
+        from :func:`gmuk.engine.integrate.simulate` also ``drifted`` (bool) and
+        ``constraint_violation`` (the constraint check: largest residuals, tolerance, one
+        entry per constraint).
     """
 
     t: FloatArray
@@ -116,7 +121,8 @@ class Trajectory:
 
     @property
     def success(self) -> bool:
-        """Whether the run reached the end of its time span."""
+        """Whether the run reached the end of its time span on its constraints (status
+        "success": not "drifted", "interrupted" or "failed")."""
         return self.status == "success"
 
     def __len__(self) -> int:
@@ -359,8 +365,9 @@ MAX_META_BYTES = 64 * 2**20
 #: (about 1e-15 per step); a looser bound than :data:`gmuk._validation.GROUP_TOL` lets
 #: files from other programs that store fewer digits load.
 POSE_TOL = 1e-6
-#: The values of :attr:`Trajectory.status`.
-STATUSES = ("success", "interrupted", "failed")
+#: The values of :attr:`Trajectory.status` ("drifted" since gmuk's drift check; files
+#: written before it carry the other three and load as they are).
+STATUSES = ("success", "drifted", "interrupted", "failed")
 _DOFS = {"rigid": 6, "point": 3, "slack": 1}
 _META_KEYS = ("format_version", "body_names", "body_kinds", "body_dofs", "status", "message")
 _NPY_MAGIC = b"\x93NUMPY"
@@ -417,8 +424,9 @@ def load_trajectory(path: str | Path, *, max_bytes: int = MAX_BYTES) -> Trajecto
           (rigid 6, point 3, slack 1), a ``status`` not in :data:`STATUSES`, a
           ``message`` that is not a string, ``stats`` that is not an object or whose
           ``n_rhs``, ``n_steps``, ``n_rejected`` (integers ≥ 0), ``method`` (str),
-          ``rtol``, ``atol`` (finite ≥ 0), ``compiled`` (bool), ``versions`` or
-          ``checkpoint`` (objects) have the wrong type;
+          ``rtol``, ``atol`` (finite ≥ 0), ``compiled``, ``drifted`` (bool),
+          ``versions``, ``checkpoint`` or ``constraint_violation`` (objects) have the
+          wrong type;
         * *arrays*: shapes that disagree with the bodies or with each other; NaN or
           infinity; times ``t`` that do not strictly increase; poses whose rotation
           block is not a rotation (‖RᵀR − I‖ or |det R − 1| above :data:`POSE_TOL`, a
@@ -682,6 +690,8 @@ def _check_stats(stats: Any, path: Path) -> None:
         "compiled": ("true or false", lambda v: isinstance(v, bool)),
         "versions": ("an object", lambda v: isinstance(v, dict)),
         "checkpoint": ("an object", lambda v: isinstance(v, dict)),
+        "drifted": ("true or false", lambda v: isinstance(v, bool)),
+        "constraint_violation": ("an object", lambda v: isinstance(v, dict)),
     }
     for key, (what, ok) in checks.items():
         if key in stats and not ok(stats[key]):

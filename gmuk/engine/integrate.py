@@ -40,6 +40,7 @@ from __future__ import annotations
 import sys
 import time
 import warnings
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -66,7 +67,7 @@ from gmuk.trajectory import _ARRAYS, Trajectory
 if TYPE_CHECKING:
     from gmuk.engine.system import Accelerations, System
 
-__all__ = ["METHODS", "compile_loop", "simulate", "versions"]
+__all__ = ["DRIFT_SAMPLES", "METHODS", "check_drift", "compile_loop", "simulate", "versions"]
 
 #: Compile the step loop now (once per machine); :func:`simulate` does it on first use.
 compile_loop = _compiled.compile_loop
@@ -233,6 +234,7 @@ def simulate(
     progress: bool | None = None,
     on_failure: str = "raise",
     compiled: bool | None = None,
+    drift_tol: float | None = 1e-6,
 ) -> Trajectory:
     """Integrate a System on SE(3)ⁿ × Rᵏ from ``state0`` over ``t_span``.
 
@@ -285,12 +287,20 @@ def simulate(
         compiled once per machine, on first use, in this process (announced on stderr in one
         line; ``gmuk compile`` does it ahead) and then loaded from numba's cache: the results do
         not depend on the cache's state.
+    drift_tol : float or None
+        How far a constraint may drift from where the run started it, in the units of its
+        residual (default 1e-6: 1 µm, 1 µrad, 1 µm/s; see Notes). A run that completes its
+        span with a constraint past it ends with ``status="drifted"`` (so
+        ``traj.success`` is False) and a GmukWarning. None measures and records the
+        violations without judging them (for runs that leave their constraint by design,
+        e.g. under unmodeled forces).
 
     Returns
     -------
     Trajectory
         ``stats`` holds the method's name, the numbers of evaluations, steps and rejected
-        steps, and the versions of gmuk, numba and numpy that computed it.
+        steps, the versions of gmuk, numba and numpy that computed it, and the constraint
+        check: ``stats["drifted"]`` (bool) and ``stats["constraint_violation"]`` (below).
 
     Raises
     ------
@@ -304,11 +314,40 @@ def simulate(
     Inside :func:`gmuk.runs.run_control` the call stops at the next step once a stop is
     requested (``status="interrupted"``, no warning), writes checkpoints of its progress, and
     resumes from them (see :mod:`gmuk.runs`); ``gmuk run`` uses this.
+
+    **Constraint drift.** The rows ``A ν̇ = b`` hold a constraint at the acceleration level
+    only: integration error that leaves it is not pulled back unless Baumgarte terms do it,
+    and can grow (exponentially, on an unstable manifold). After the run, every constraint
+    that states its residuals (:meth:`gmuk.Constraint.violation`: holonomic φ and φ̇,
+    nonholonomic ψ, inequalities' slack equalities, tracking errors log(g_d⁻¹ g) and the
+    twist error, a relative constraint's twist error) is evaluated at the output times (at
+    most :data:`DRIFT_SAMPLES` of them, evenly spread, first and last included). A
+    constraint whose residuals all start within ``drift_tol`` (2-norm) is *drifted* when the
+    norm of one of them grows by more than ``drift_tol`` above its start value. A
+    constraint that starts off its manifold (a disturbed start that Baumgarte terms or a
+    controller bring back) is recorded but not judged: its velocity error must first grow
+    while it converges. ``stats["constraint_violation"]`` holds ``position`` and
+    ``velocity`` (the largest norms over the constraints and outputs, each in its
+    residual's units, None when no constraint states that level), ``tolerance``,
+    ``drifted``, ``samples`` and one entry per constraint (``name``, ``position``,
+    ``velocity``, their start values, ``on_start``, ``drifted``, ``t_drifted``). The
+    tolerance applies to each residual as the constraint states it: the tracking
+    constraints weigh translations against the reference's distance and speed (as the
+    integrator's error weights do) and keep rotations in rad; a user's residual has its
+    own units, for which gmuk knows no scale (raise ``drift_tol`` for a residual in m on a
+    scale of 1e6 m or more). 1e-6 is far above what the integrator leaves on a stabilised
+    or stable constraint (FCEI over 12 orbits: 7e-14 rad and 2.4e-7 m, 8e-14 of its
+    distance) and far below a drift that spoils a result (unstabilised FCEI passes it
+    within 4 orbits and ends π rad off). An interrupted or failed run
+    is checked and recorded too, its status unchanged; a residual that raises is
+    recorded under ``error`` and judged as not drifted.
     """
     run = check_run(
         system, state0, t_span, t_eval=t_eval, method=method, rtol=rtol, atol=atol, step=step,
         first_step=first_step, max_step=max_step, max_steps=max_steps, on_failure=on_failure,
     )  # fmt: skip
+    if drift_tol is not None:
+        drift_tol = real_number(drift_tol, "drift_tol", positive=True)
     if progress is not None and not isinstance(progress, (bool, np.bool_)):
         raise DefinitionError(f"progress must be True, False or None; got {progress!r}")
     if compiled is not None:
@@ -344,7 +383,7 @@ def simulate(
         if control is not None and control.resume and checkpoint.exists():
             prefix, record = runs.load(checkpoint, fingerprint)
             if record["complete"]:
-                return prefix
+                return check_drift(system, prefix, drift_tol)
     packing = _Packing(system)
     rec = _Recorder(packing, prefix)
     loop = _Loop(packing, run)
@@ -366,12 +405,120 @@ def simulate(
             traj = rec.build(status, message, loop.stats())
             bar.close()
             loop.save_checkpoint(traj)
-            raise SimulationError(message, traj) from exc
+            raise SimulationError(message, check_drift(system, traj, drift_tol)) from exc
     finally:
         bar.close()
     traj = rec.build(status, message, loop.stats())
-    loop.save_checkpoint(traj)
-    return traj
+    loop.save_checkpoint(traj)  # before the drift check: a checkpoint records the run itself
+    return check_drift(system, traj, drift_tol)
+
+
+#: The most output times at which :func:`check_drift` evaluates the constraints' residuals.
+DRIFT_SAMPLES = 2001
+
+
+def check_drift(system: System, traj: Trajectory, drift_tol: float | None) -> Trajectory:
+    """``traj`` with the constraint check of :func:`simulate` (its Notes, "Constraint
+    drift") in ``stats``; a completed run whose constraint drifted past ``drift_tol`` gets
+    ``status="drifted"``, a message saying which and when, and a GmukWarning."""
+    n = len(traj)
+    picks = np.arange(n) if n <= DRIFT_SAMPLES else np.linspace(0, n - 1, DRIFT_SAMPLES)
+    idx = np.unique(np.round(picks).astype(np.int64))
+    states = [traj.state(int(i)) for i in idx] if system.constraints else []
+    found = [_constraint_drift(c, states, drift_tol) for c in system.constraints]
+    entries = [e for e in found if e is not None]
+
+    def largest(level: str) -> float | None:
+        values = [e[level] for e in entries if e[level] is not None]
+        return max(values) if values else None
+
+    drifted = [e for e in entries if e["drifted"]]
+    check = {
+        "position": largest("position"),
+        "velocity": largest("velocity"),
+        "tolerance": drift_tol,
+        "drifted": bool(drifted),
+        "samples": len(states),
+        "constraints": entries,
+    }
+    status, message = traj.status, traj.message
+    stats = {**traj.stats, "drifted": bool(drifted), "constraint_violation": check}
+    if drifted:
+        first = min(drifted, key=lambda e: e["t_drifted"])
+        what = (
+            f"constraint {first['name']!r} drifted off: its residual grew past drift_tol = "
+            f"{drift_tol:g} at t = {first['t_drifted']:.9g} s (largest ‖position‖ "
+            f"{_show(first['position'])}, ‖velocity‖ {_show(first['velocity'])}, in its units)"
+        )
+        if status == "success":
+            status, message = "drifted", what
+        else:
+            message = f"{message}; {what}"
+        warnings.warn(
+            f"{what}: the run is not on its constraint (stabilise it with gmuk.Baumgarte; "
+            "docs/reliability.rst, 'Constraint drift')",
+            GmukWarning,
+            stacklevel=3,
+        )
+    return replace(traj, status=status, message=message, stats=stats)
+
+
+def _show(value: float | None) -> str:
+    return "n/a" if value is None else f"{value:.3g}"
+
+
+def _constraint_drift(con: Any, states: list[State], tol: float | None) -> dict[str, Any] | None:
+    """One constraint's entry of the drift check over ``states``; None when it states no
+    residual."""
+    violation = getattr(con, "violation", None)
+    if violation is None or not states:
+        return None
+    name = str(getattr(con, "name", type(con).__name__))
+    norms: dict[str, list[float]] = {"position": [], "velocity": []}
+    try:
+        for s in states:
+            pos, vel = violation(s)
+            for level, value in (("position", pos), ("velocity", vel)):
+                if value is not None:
+                    v = float(np.linalg.norm(np.asarray(value, dtype=float)))
+                    norms[level].append(v if v == v else np.inf)
+    except Exception as exc:  # a part's residual failing: recorded, the run is kept
+        warnings.warn(
+            f"the drift check of constraint {name!r} failed ({_describe(exc)}); not checked",
+            GmukWarning,
+            stacklevel=4,
+        )
+        return {"name": name, "position": None, "velocity": None, "initial_position": None,
+                "initial_velocity": None, "on_start": None, "drifted": False,
+                "t_drifted": None, "error": _describe(exc)}  # fmt: skip
+    if not norms["position"] and not norms["velocity"]:
+        return None
+    times = np.array([s.t for s in states])
+    start = {k: (v[0] if v else None) for k, v in norms.items()}
+    on_start = all(v is None or v <= tol for v in start.values()) if tol is not None else None
+    t_drifted = None
+    if on_start:
+        for values in norms.values():
+            if values:
+                arr = np.array(values)
+                over = np.nonzero(arr > arr[0] + (tol or 0.0))[0]
+                if over.size:
+                    t = float(times[over[0]])
+                    t_drifted = t if t_drifted is None else min(t_drifted, t)
+
+    def finite(v: float) -> float | None:
+        return v if np.isfinite(v) else None
+
+    return {
+        "name": name,
+        "position": finite(max(norms["position"])) if norms["position"] else None,
+        "velocity": finite(max(norms["velocity"])) if norms["velocity"] else None,
+        "initial_position": None if start["position"] is None else finite(start["position"]),
+        "initial_velocity": None if start["velocity"] is None else finite(start["velocity"]),
+        "on_start": on_start,
+        "drifted": t_drifted is not None,
+        "t_drifted": t_drifted,
+    }
 
 
 def _describe(exc: BaseException) -> str:
