@@ -43,6 +43,20 @@ CENTRAL_RADIUS = MOON_RADIUS
 #: benchmarks/README.md).
 RTOL, ATOL = 3e-15, 1e-12
 SAMPLES_PER_ORBIT = 721
+#: Natural frequency (rad/s) of the Baumgarte terms that keep the R⁶ tracking constraints on
+#: the reference over long runs. Unstabilised, FCEI's attitude error grows like e^{2.8 per
+#: orbit} (≈ e^{t/8000 s}: the LVLH attitude of this spacecraft is an unstable equilibrium of
+#: its constrained error dynamics) from round-off, 6e-14 rad after one orbit, 2e-8 after three,
+#: π rad by the sixth. Critical gains at ω_n = 1e-3 s⁻¹ (α = 2e-3 s⁻¹, β = 1e-6 s⁻²) damp
+#: errors eight times faster than that growth and stay 2–4 times above the reference's turn
+#: rate (2.8e-4 to 4.5e-4 rad/s), below which Baumgarte terms acting in the body frame couple
+#: the axes (:class:`gmuk.ConfigurationTracking`). Stiffer gains cost steps without gain: at
+#: rtol 3e-15 the terms feed the round-off of the errors back into the accelerations, so the
+#: step count grows with ω_n (12 orbits: 1635 steps unstabilised, 4153 at 1e-3, 15 010 at
+#: 3e-3, 75 008 at 1e-2). docs/scenarios/chapter4.rst gives the figures.
+TRACKING_BAUMGARTE = gmuk.Baumgarte.critical(1e-3)
+#: The velocity-level gain α (1/s) of the virtual pair's relative constraint, the same rate.
+RELATIVE_BAUMGARTE = gmuk.Baumgarte(alpha=2e-3)
 #: The one option of every Chapter 4 scenario.
 ORBITS = Option(
     "orbits", positive_float, 1.0, "orbits to simulate, in periods of the reference orbit"
@@ -80,9 +94,11 @@ def fully_constrained(
     orbits: float,
     *,
     tangent: bool = False,
-    baumgarte: gmuk.Baumgarte | None = None,
+    baumgarte: gmuk.Baumgarte | None = TRACKING_BAUMGARTE,
 ) -> Trajectory:
-    """One spacecraft tracking the modified-LVLH reference: R⁶ (Eq. 67) or T²SE(3) (Eq. 80)."""
+    """One spacecraft tracking the modified-LVLH reference: R⁶ (Eq. 67, with ``baumgarte``
+    terms, :data:`TRACKING_BAUMGARTE` by default; None for the thesis's bare rows) or
+    T²SE(3) (Eq. 80, whose rows take no Baumgarte terms: the drift check flags its long runs)."""
     sc = spacecraft()
     ref = LVLHReference(orbit)
     con: gmuk.Constraint = (
@@ -101,7 +117,9 @@ def virtual_pair(
     orbit: KeplerOrbit, orbits: float, torque: Callable[[float], Any] | None = None
 ) -> Trajectory:
     """The under-constrained pair of Section 4.1.3: "virtual" tracks the reference, and
-    "spacecraft" is held to it in five relative directions, free to roll about axis 1."""
+    "spacecraft" is held to it in five relative directions, free to roll about axis 1.
+    Stabilised as :func:`fully_constrained` (:data:`TRACKING_BAUMGARTE` on the tracking,
+    :data:`RELATIVE_BAUMGARTE` on the relative twist)."""
     virtual, sc = spacecraft("virtual"), spacecraft()
     ref = LVLHReference(orbit)
     forces: list[gmuk.ForceModel] = [gmuk.GravityGradient(orbit.mu)]
@@ -110,8 +128,8 @@ def virtual_pair(
     system = gmuk.System(
         [virtual, sc],
         [
-            gmuk.ConfigurationTracking(virtual, ref),
-            gmuk.RelativeConstraint(sc, virtual, free_axes=[0]),
+            gmuk.ConfigurationTracking(virtual, ref, baumgarte=TRACKING_BAUMGARTE),
+            gmuk.RelativeConstraint(sc, virtual, free_axes=[0], baumgarte=RELATIVE_BAUMGARTE),
         ],
         forces,
     )

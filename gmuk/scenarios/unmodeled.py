@@ -306,10 +306,12 @@ def run(
     t = common.time_grid(orbit, orbits)
     system, ctl = _system(HarmonicPerturbation(moon), {"robust": robust, "k_integral": k_integral})
     assert ctl is not None
+    # The unmodeled force moves the plant off the UK constraint by design (what these two
+    # runs measure): their constraint violation is recorded, not judged (drift_tol=None).
     controlled = _from_nominal(
-        system, t, rtol=rtol, atol=rtol, method=METHOD, max_step=fccl.MAX_STEP
+        system, t, rtol=rtol, atol=rtol, method=METHOD, max_step=fccl.MAX_STEP, drift_tol=None
     )
-    quiet = {"rtol": common.RTOL, "atol": common.ATOL}
+    quiet = {"rtol": common.RTOL, "atol": common.ATOL, "drift_tol": None}
     uncontrolled = _from_nominal(_system(HarmonicPerturbation(moon), None)[0], t, **quiet)
     nominal = fccl.simulate_nominal(orbit, t)
     view = controlled.body(BODY)
