@@ -189,15 +189,14 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
     r_off, e_off, io = parts.rigid_offsets, parts.euclid_offsets, parts.io
     nr, ne, ndof, s, nc = d.n_rigid, d.n_euclid, d.n_dof, d.n_rows, d.n_control
     total = aux[:ndof]
-    xi = np.empty((nr, 6))
-    V = np.empty((nr, 6))
+    # views of Y, not copies: nothing is allocated per evaluation that a view can replace
+    xi = Y[: 6 * nr].reshape((nr, 6))
+    V = Y[6 * nr : 12 * nr].reshape((nr, 6))
     any_xi = False
-    for k in range(nr):
-        for i in range(6):
-            xi[k, i] = Y[6 * k + i]
-            V[k, i] = Y[6 * nr + 6 * k + i]
-            if xi[k, i] != 0.0:
-                any_xi = True
+    for i in range(6 * nr):
+        if Y[i] != 0.0:
+            any_xi = True
+            break
     g = np.empty((nr, 4, 4))
     if nr:
         _compose_exp_into(G0, xi, g)
@@ -215,11 +214,7 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
     # dY = [dexp⁻¹(ξ) V, V̇, ẋ, ẍ, ż]
     if nr:
         if any_xi:
-            xd = np.empty((nr, 6))
-            _dexp_inv_apply_into(xi, V, xd)
-            for k in range(nr):
-                for i in range(6):
-                    dY[6 * k + i] = xd[k, i]
+            _dexp_inv_apply_into(xi, V, dY[: 6 * nr].reshape((nr, 6)))
         else:
             for i in range(6 * nr):
                 dY[i] = Y[6 * nr + i]
@@ -237,7 +232,7 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
     return DONE
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-untyped-def]
     """The accelerations of a FREE, FUSED or DENSE program into ``aux`` (see :func:`rhs`):
     compiled force terms, then the parts in Python, the solve, the controllers and the loads
@@ -254,10 +249,15 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
     for i in range(ndof):
         unmodeled[i] = 0.0
     w = np.empty(6)
-    gp = np.zeros((4, 4))
-    vp = np.zeros(6)
-    no_inertia = np.zeros((3, 3))
     x0 = 12 * nr
+    if d.point_terms:  # a point mass's pose and velocity, as its force kernels take them
+        gp = np.zeros((4, 4))
+        vp = np.zeros(6)
+        no_inertia = np.zeros((3, 3))
+    else:
+        gp = np.empty((0, 0))
+        vp = np.empty(0)
+        no_inertia = gp
     for f in range(terms.shape[0]):
         kernel, rig, idx, off = terms[f, 0], terms[f, 1], terms[f, 2], terms[f, 3]
         p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]

@@ -122,6 +122,8 @@ class Dims(NamedTuple):
     python_parts: int
     #: the rank reported without constraints (the solve's own, −1 for none)
     free_rank: int
+    #: whether any compiled force term acts on a point mass
+    point_terms: int
 
 
 class Parts(NamedTuple):
@@ -360,6 +362,7 @@ def build(view: SystemView, method: RungeKuttaMethod, state: State) -> Program:
         accel_at=python.accel_at,
         python_parts=int(bool(py_forces or py_constraints or py_controllers)),
         free_rank=free_rank,
+        point_terms=int(bool(terms.shape[0]) and not terms[:, 1].all()),
     )
     parts = Parts(
         terms=terms,
@@ -535,16 +538,20 @@ class PythonParts:
         return 0
 
     def state(self) -> State:
-        """The state the loop wrote into ``io``: copies, read-only (:meth:`State._adopt`),
-        so a part that writes into it fails instead of changing the loop's state."""
+        """The state the loop wrote into ``io``: one read-only copy of it, viewed as the
+        State's arrays (:meth:`State._adopt`), so a part that writes into it fails instead
+        of changing the loop's state."""
         io, lay = self.io, self.layout
+        block = io[1 : self.loads_at].copy()  # g, V, x, ẋ, z: one copy, frozen once
+        block.setflags(write=False)
+        g, V, x, xd, z = self._g, self._V, self._x, self._xd, self._z
         return self._make_state(
             float(io[0]),
-            io[self._g].reshape(lay.n_rigid, 4, 4).copy(),
-            io[self._V].reshape(lay.n_rigid, 6).copy(),
-            io[self._x].copy(),
-            io[self._xd].copy(),
-            io[self._z].copy(),
+            block[g.start - 1 : g.stop - 1].reshape(lay.n_rigid, 4, 4),
+            block[V.start - 1 : V.stop - 1].reshape(lay.n_rigid, 6),
+            block[x.start - 1 : x.stop - 1],
+            block[xd.start - 1 : xd.stop - 1],
+            block[z.start - 1 : z.stop - 1],
             lay,
         )
 
