@@ -197,12 +197,11 @@ class State:
     ) -> State:
         """A State that takes over fresh float64 arrays no one else holds (they are made
         read-only here, not copied or checked): for the engine's own copies, which it hands
-        over. Cheaper than the constructor (the compiled loop's callback makes one per call)."""
-        g.setflags(write=False)
-        V.setflags(write=False)
-        x.setflags(write=False)
-        xdot.setflags(write=False)
-        z.setflags(write=False)
+        over. Cheaper than the constructor (the compiled loop's callback makes one per call,
+        as read-only views of one frozen copy)."""
+        for a in (g, V, x, xdot, z):
+            if a.flags.writeable:
+                a.setflags(write=False)
         obj = object.__new__(cls)
         obj.__dict__.update(t=t, g=g, V=V, x=x, xdot=xdot, z=z, layout=layout)
         return obj

@@ -37,7 +37,7 @@ from gmuk.engine import _uk_kernels, solvers, uk
 from gmuk.engine.integrate import simulate as _simulate
 from gmuk.engine.integrators import _program
 from gmuk.engine.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
-from gmuk.errors import ConstraintError, DefinitionError, NonFiniteError
+from gmuk.errors import ConstraintError, DefinitionError, GmukError, NonFiniteError
 from gmuk.forces.base import ForceModel
 from gmuk.state import Layout, State
 
@@ -521,11 +521,10 @@ class System:
         t = state.t
         for f, bodies, slots in plan:
             target = modeled if f.modeled else unmodeled
-            who = f"force {f.name!r}"
             try:
                 if slots is None:
                     for body, w in zip(bodies, f.wrenches(state, bodies), strict=True):
-                        self._add(target, body, w, who, t)
+                        self._add(target, body, w, f, t)
                 else:
                     for body, rigid, i, offset, dof in slots:
                         if rigid:
@@ -533,25 +532,27 @@ class System:
                         else:
                             w = f.force(t, state.x[i : i + dof], state.xdot[i : i + dof], body)
                         if type(w) is not np.ndarray or w.shape != (dof,) or w.dtype != np.float64:
-                            w = _part_output(w, (dof,), who, body, t)
+                            w = _part_output(w, (dof,), f, body, t)
                         target[offset : offset + dof] += w
             except ValueError as exc:
-                _raise_if_read_only(exc, who, t)
+                _raise_if_read_only(exc, f, t)
                 raise
             if not all_finite(target):  # once per model: it added NaN or inf
-                self._not_finite(target, bodies, who, t)
+                self._not_finite(target, bodies, f, t)
 
-    def _not_finite(self, target: FloatArray, bodies: Iterable[Body], who: str, t: float) -> None:
+    def _not_finite(self, target: FloatArray, bodies: Iterable[Body], part: Any, t: float) -> None:
         """Raise NonFiniteError naming the first of ``bodies`` whose entries of ``target``
         (n_dof,) are not finite (the load a part just added)."""
         for body in bodies:
             s = self.layout.slot(body)
             if not all_finite(target[s.offset : s.offset + s.dof]):
                 raise NonFiniteError(
-                    f"{who} returned a non-finite load (NaN or inf) for {body.kind} body "
+                    f"{_who(part)} returned a non-finite load (NaN or inf) for {body.kind} body "
                     f"{body.name!r} at t = {t:.9g} s (or loads whose sum is beyond float64)"
                 )
-        raise NonFiniteError(f"{who} returned a non-finite load (NaN or inf) at t = {t:.9g} s")
+        raise NonFiniteError(
+            f"{_who(part)} returned a non-finite load (NaN or inf) at t = {t:.9g} s"
+        )
 
     def _force_slot(self, body: Body) -> tuple[Body, bool, int, int, int]:
         s = self.layout.slot(body)
@@ -579,48 +580,49 @@ class System:
         t = state.t
         for k in which:
             c, bodies, sl = self.controllers[k], self._ctrl_bodies[k], self._ctrl_slices[k]
-            who = f"controller {c.name!r}"
             try:
                 if c.uses_modeled_acceleration:
                     out = c.control(state, state.z[sl], modeled)
                 else:
                     out = c.control(state, state.z[sl])
             except ValueError as exc:
-                _raise_if_read_only(exc, who, t)
+                _raise_if_read_only(exc, c, t)
                 raise
             if not (isinstance(out, (tuple, list)) and len(out) == 2):
                 raise DefinitionError(
-                    f"{who}: control() must return a pair (u, z_dot); got "
+                    f"{_who(c)}: control() must return a pair (u, z_dot); got "
                     f"{type(out).__name__} {out!r:.60}"
                 )
             u, zd = out
             try:
-                pairs = list(zip(bodies, u, strict=True))
-            except (TypeError, ValueError):
+                for body, w in zip(bodies, u, strict=True):
+                    self._add(control, body, w, c, t)
+            except (TypeError, ValueError) as exc:
+                if isinstance(exc, GmukError):
+                    raise
                 raise DefinitionError(
-                    f"{who}: control() must return one load per body ({len(bodies)}) as a "
+                    f"{_who(c)}: control() must return one load per body ({len(bodies)}) as a "
                     f"sequence; got {type(u).__name__} {u!r:.60}"
                 ) from None
-            for body, w in pairs:
-                self._add(control, body, w, who, t)
             n = sl.stop - sl.start
             if type(zd) is not np.ndarray or zd.shape != (n,) or zd.dtype != np.float64:
-                zd = _part_output(zd, (n,), who, None, t)
+                zd = _part_output(zd, (n,), c, None, t)
             z_dot[sl] = zd
             if not all_finite(control):
-                self._not_finite(control, bodies, who, t)
+                self._not_finite(control, bodies, c, t)
             if not all_finite(zd):
                 raise NonFiniteError(
-                    f"{who} returned a non-finite z_dot (NaN or inf) at t = {t:.9g} s: {zd!r:.80}"
+                    f"{_who(c)} returned a non-finite z_dot (NaN or inf) at t = {t:.9g} s: "
+                    f"{zd!r:.80}"
                 )
         return control, z_dot
 
-    def _add(self, target: FloatArray, body: Body, w: Any, who: str, t: float) -> None:
+    def _add(self, target: FloatArray, body: Body, w: Any, part: Any, t: float) -> None:
         """Add a part's load ``w`` for ``body`` into ``target`` (n_dof,), checked as
         :func:`_part_output` checks it (finiteness is the caller's, once per part)."""
         s = self.layout.slot(body)
         if type(w) is not np.ndarray or w.shape != (s.dof,) or w.dtype != np.float64:
-            w = _part_output(w, (s.dof,), who, body, t)
+            w = _part_output(w, (s.dof,), part, body, t)
         target[s.offset : s.offset + s.dof] += w
 
     def constraint_rows(self, state: State) -> tuple[FloatArray | sp.csr_matrix, FloatArray]:
@@ -861,7 +863,7 @@ class System:
 
 
 def _part_output(
-    w: Any, shape: tuple[int, ...], who: str, body: Body | None, t: float
+    w: Any, shape: tuple[int, ...], part: Any, body: Body | None, t: float
 ) -> FloatArray:
     """A part's return value ``w`` as a float64 array of ``shape``, refusing what is not an
     array of real numbers (booleans, complex numbers, strings, objects: dtype kinds other
@@ -881,13 +883,13 @@ def _part_output(
     if arr is None or arr.dtype.kind not in "fiu":
         got = f"{type(w).__name__}" if arr is None else f"dtype {arr.dtype}"
         raise DefinitionError(
-            f"{who} returned {got} {w!r:.60} {what} at t = {t:.9g} s; expected an array of "
+            f"{_who(part)} returned {got} {w!r:.60} {what} at t = {t:.9g} s; expected an array of "
             f"real numbers (float or int; not bool, complex or str) of shape {shape}"
         )
     if arr.shape != shape and not (body is None and arr.size == shape[0]):
         expected = f"{shape[0]} entries" if body is None else f"shape {shape}"
         raise DefinitionError(
-            f"{who} returned shape {arr.shape} {what} at t = {t:.9g} s; expected {expected}"
+            f"{_who(part)} returned shape {arr.shape} {what} at t = {t:.9g} s; expected {expected}"
         )
     return arr.astype(np.float64).reshape(shape)
 
@@ -899,7 +901,7 @@ def _pair(c: Constraint, state: State) -> tuple[Any, Any]:
     try:
         out = c.rows(state)
     except ValueError as exc:
-        _raise_if_read_only(exc, f"constraint {c.name!r}", state.t)
+        _raise_if_read_only(exc, c, state.t)
         raise
     if type(out) is tuple and len(out) == 2:
         A, b = out
@@ -939,13 +941,26 @@ def _not_bool(x: Any, c: Constraint, state: State, name: str) -> None:
         )
 
 
-def _raise_if_read_only(exc: ValueError, who: str, t: float) -> None:
+def _raise_if_read_only(exc: ValueError, part: Any, t: float) -> None:
     """Raise a DefinitionError naming the part when ``exc`` is numpy's refusal to write into
     a read-only array: the part wrote into the State (or the modeled acceleration) it was
     given, which are read-only so that no part can change the caller's data."""
     if "read-only" in str(exc):
         raise DefinitionError(
-            f"{who} tried to write into the arrays it was given at t = {t:.9g} s ({exc}): a "
+            f"{_who(part)} tried to write into the arrays it was given at t = {t:.9g} s ({exc}): a "
             "State and the modeled acceleration are read-only; copy them "
             "(e.g. state.V.copy()) to compute in place"
         ) from exc
+
+
+def _who(part: Any) -> str:
+    """How messages name a part: "force 'Drag'", "controller 'PD'", "constraint 'Rows'"
+    (built only when a message is, not on every call)."""
+    kind = (
+        "force"
+        if isinstance(part, ForceModel)
+        else "controller"
+        if isinstance(part, Controller)
+        else "constraint"
+    )
+    return f"{kind} {part.name!r}"
