@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 import gmuk
-from gmuk.engine.integrate import _Problem
+from gmuk.testing import _ReferenceProblem as _Problem
 from gmuk.orbits import KeplerOrbit, LVLHReference, fcei_orbit
 from gmuk.scenarios import _lvlh as common
 from gmuk.scenarios import fcei

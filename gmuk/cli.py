@@ -112,7 +112,7 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("--verbose", action="store_true", help="print each row as computed")
     sub.add_parser(
         "compile",
-        help="compile the step loop now (once per machine, 30-60 s; the first run compiles it "
+        help="compile the step loop now (once per machine, 20-40 s; the first run compiles it "
         "otherwise, and says so)",
     )
     _add_view_parser(sub)

@@ -131,9 +131,11 @@ def _rhs_signature() -> Any:
     return types.int64(*(typeof(x) for x in (0.0, v, G, parts, v, v, ints)))
 
 
-#: The signature :func:`rhs` is compiled for, and the caller of that compiled function: the
-#: loop's steps call the right-hand side through its address (``ints[I_RHS_KERNEL]``), so
-#: that its code is compiled once, not again inside each function of the loop that calls it.
+#: The signature :func:`rhs` is compiled for, and the caller of that compiled function. A
+#: step's stages call :func:`rhs` directly (a call through an address costs about 0.3 µs
+#: more on a rigid body: its arguments go through memory); the rarer evaluations (the start,
+#: the starting step, the continuous extension) call it through its address
+#: (``ints[I_RHS_KERNEL]``), so that its code is not compiled again inside each of them.
 RHS_SIGNATURE = _rhs_signature()
 _call_rhs = kernel_caller(RHS_SIGNATURE, "right-hand side")
 
@@ -827,9 +829,7 @@ def advance(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux
         for i in range(1, m.n_stages):
             _stage_state(Y, h_try, m.A[i], K, i, Yt)
             ints[I_RHS] += 1
-            status = _call_rhs(
-                ints[I_RHS_KERNEL], (t + m.c[i] * h_try, Yt, G0, parts, K[i], aux1, ints)
-            )
+            status = rhs(t + m.c[i] * h_try, Yt, G0, parts, K[i], aux1, ints)
             if status != DONE:
                 status = _fail(status, t + m.c[i] * h_try, fs, ints)
                 break
@@ -837,9 +837,7 @@ def advance(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux
             break
         _stage_state(Y, h_try, m.b, K, m.n_stages, Y1)
         ints[I_RHS] += 1
-        status = _call_rhs(
-            ints[I_RHS_KERNEL], (t + h_try, Y1, G0, parts, Yt, aux1, ints)
-        )  # Yt: f(t + h, y₁)
+        status = rhs(t + h_try, Y1, G0, parts, Yt, aux1, ints)  # Yt: f(t + h, y₁)
         if status != DONE:
             status = _fail(status, t + h_try, fs, ints)
             break
@@ -905,7 +903,7 @@ def advance(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux
 
 # --------------------------------------------------------------- compiling, once per machine
 #: What a cold compilation of the loop takes on a 2-core machine (s), as announced.
-EXPECTED_COMPILE_S = "30-60 s"
+EXPECTED_COMPILE_S = "20-40 s"
 _ready = False  # the loop is compiled or loaded in this process (every program's types)
 
 
@@ -959,7 +957,7 @@ def _load(kernel: Any, sig: Any) -> bool:
 def compile_loop(*, announce: bool = True, timeout: float = 900.0) -> bool:
     """Compile the step loop once for this machine, or load it from numba's cache.
 
-    Compiling takes 30–60 s on a 2-core machine (once; later processes load the loop in a
+    Compiling takes 20–40 s on a 2-core machine (once; later processes load the loop in a
     fraction of a second). With ``announce`` it says so on stderr, in one line, before it
     starts. One process compiles at a time per cache folder: the others wait on a lock (an
     advisory lock that the operating system releases when its process ends, killed or
