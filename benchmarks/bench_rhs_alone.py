@@ -16,8 +16,8 @@ import time
 
 import numba
 import numpy as np
+from bench_rigid_rhs import case
 
-import gmuk
 from gmuk.engine.integrators import _compiled, get_method
 
 
@@ -30,19 +30,13 @@ def _calls(n, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
 
 
 def main() -> None:
-    mu, r0 = 4.9028e12, 1838e3
-    sc = gmuk.RigidBody("sc", 500.0, np.diag([100.0, 200.0, 300.0]))
-    system = gmuk.System([sc], [], [gmuk.GravityGradient(mu)])
-    g = np.eye(4)
-    g[0, 3] = r0
-    v = np.sqrt(mu / r0) * np.array([0.0, np.cos(np.radians(80)), np.sin(np.radians(80))])
-    state = system.state(g={"sc": g}, V={"sc": [0.001, 0.002, 0.003, *v]})
+    system, state = case()
     prog = system.compiled_program(get_method("DOP853"), state)
     _compiled.compile_loop()
     Y = np.zeros(12)
     Y[:6] = 1e-3
-    Y[6:] = [0.001, 0.002, 0.003, *v]
-    args = (Y, np.array([g]), prog.parts, np.empty(12), np.empty(prog.n_aux))
+    Y[6:] = state.V[0]
+    args = (Y, state.g.copy(), prog.parts, np.empty(12), np.empty(prog.n_aux))
     ints = np.zeros(_compiled.N_INTS, np.int64)
     _calls(10, *args, ints)
     n, best = 200_000, float("inf")

@@ -21,14 +21,20 @@ import numpy as np
 import gmuk
 
 
-def main() -> None:
+def case() -> tuple[gmuk.System, gmuk.State]:
+    """The System (one rigid body, point-mass Moon plus gravity gradient) and its state at
+    periselene of a 1838 km circular orbit inclined at 80°."""
     mu, r0 = 4.9028e12, 1838e3
     sc = gmuk.RigidBody("sc", 500.0, np.diag([100.0, 200.0, 300.0]))
     system = gmuk.System([sc], [], [gmuk.GravityGradient(mu)])
     g = np.eye(4)
     g[0, 3] = r0
     v = np.sqrt(mu / r0) * np.array([0.0, np.cos(np.radians(80)), np.sin(np.radians(80))])
-    state = system.state(g={"sc": g}, V={"sc": [0.001, 0.002, 0.003, *v]})
+    return system, system.state(g={"sc": g}, V={"sc": [0.001, 0.002, 0.003, *v]})
+
+
+def main() -> None:
+    system, state = case()
     options = {"rtol": 1e-11, "atol": 1e-11}
     traj = system.simulate(state, (0.0, 7200.0), **options)
     walls = []
