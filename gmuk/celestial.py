@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray, as_array
+from gmuk._validation import FloatArray, as_array, real_number
 from gmuk.errors import DefinitionError
 
 __all__ = ["INERTIAL", "CelestialBody", "UniformRotation"]
@@ -48,8 +48,9 @@ class UniformRotation:
     angle0: float = 0.0
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.rate) and np.isfinite(self.angle0)):
-            raise DefinitionError(f"rotation rate and angle must be finite; got {self!r}")
+        # real numbers only: a bool, complex number, string or array is refused, not converted
+        object.__setattr__(self, "rate", real_number(self.rate, "rotation rate"))
+        object.__setattr__(self, "angle0", real_number(self.angle0, "rotation angle0"))
 
     def angle(self, t: Any) -> Any:
         """η(t) (rad)."""
@@ -127,10 +128,16 @@ class CelestialBody:
                     "gmuk.UniformRotation(rate) or rotation=gmuk.INERTIAL (also in "
                     "gmuk.celestial) explicitly"
                 )
-        if mu is None or not (np.isfinite(mu) and mu > 0):
-            problems.append(f"mu must be a finite GM > 0 (m³/s²); got {mu!r}")
-        if radius is None or not (np.isfinite(radius) and radius > 0):
-            problems.append(f"radius must be > 0 (m); got {radius!r}")
+        if not isinstance(name, str) or not name:
+            problems.append(f"name must be a non-empty string; got {name!r}")
+        for label, given, what in (
+            ("mu", mu, "mu must be a finite GM > 0 (m³/s²)"),
+            ("radius", radius, "radius must be a finite number > 0 (m)"),
+        ):
+            try:
+                real_number(given, label, positive=True)
+            except DefinitionError:
+                problems.append(f"{what}; got {given!r}")
         if rotation is not None and not isinstance(rotation, UniformRotation):
             problems.append(f"rotation must be a UniformRotation; got {type(rotation).__name__}")
         if problems:

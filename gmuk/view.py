@@ -28,12 +28,13 @@ one-orbit FCEI run, 721 outputs: 5.06 MB).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, real_number, strict_integer
 from gmuk.errors import DefinitionError
 from gmuk.trajectory import Trajectory, write_text_atomic
 
@@ -62,10 +63,16 @@ def decimate(n: int, most: int) -> np.ndarray:
     ndarray (k,) of int
         Increasing indices, ``k = min(n, most)``.
     """
-    if n < 1:
+    # integers only: a string, a bool, a float or an array is refused, not compared
+    if isinstance(n, (int, np.integer)) and not isinstance(n, (bool, np.bool_)) and n < 1:
         raise DefinitionError(f"a view needs at least one output; got {n}")
-    if most < 2:
-        raise DefinitionError(f"the number of outputs to keep must be ≥ 2; got {most}")
+    n = strict_integer(n, "the number of outputs", minimum=1, maximum=2**62)
+    try:
+        most = strict_integer(most, "most", minimum=2, maximum=10**8)
+    except DefinitionError:
+        raise DefinitionError(
+            f"the number of outputs to keep must be ≥ 2 (an integer); got {most!r:.80}"
+        ) from None
     if n <= most:
         return np.arange(n)
     return np.unique(np.round(np.linspace(0, n - 1, most)).astype(np.int64))
@@ -143,7 +150,16 @@ def view_html(
             f"nothing to draw: the trajectory has no rigid body or point mass "
             f"(bodies {list(traj.body_names)}, kinds {list(traj.body_kinds)})"
         )
+    if not isinstance(title, str):
+        raise DefinitionError(f"title must be a string; got {title!r:.80}")
     for label, value in (("central_radius", central_radius), ("triad_length", triad_length)):
+        try:
+            if value is not None:
+                real_number(value, label, positive=True)
+        except DefinitionError:
+            raise DefinitionError(
+                f"{label} must be a finite number > 0 (m); got {value!r:.80}"
+            ) from None
         if value is not None and not (np.isfinite(value) and value > 0):
             raise DefinitionError(f"{label} must be a finite number > 0 (m); got {value!r}")
     n = len(traj)
@@ -347,6 +363,8 @@ def write_view(
         The file or its folder cannot be written (permissions, a file where a folder
         should be); ``gmuk view`` reports it as a message with exit status 2.
     """
+    if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
+        raise DefinitionError(f"write_view: path must be a str or a Path; got {path!r:.80}")
     path = Path(path)
     if path.is_dir():
         raise DefinitionError(

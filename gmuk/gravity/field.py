@@ -641,7 +641,11 @@ def _rebuild(
 def _positive(x: Any, name: str, unit: str, label: str) -> float:
     """``x`` as a finite float > 0, or raise DefinitionError."""
     try:
+        if isinstance(x, (bool, np.bool_, str, bytes)):  # refused, not read as 1.0 or parsed
+            raise TypeError
         v = float(x)
+    except OverflowError:  # an int beyond float64
+        v = math.inf
     except (TypeError, ValueError):
         raise DefinitionError(f"{label}: {name} must be a number > 0 ({unit}); got {x!r}") from None
     if not (math.isfinite(v) and v > 0):
@@ -653,7 +657,7 @@ def _coefficients(a: Any, name: str, label: str) -> FloatArray:
     """A finite square 2-D float array, or raise ShapeError / NonFiniteError."""
     try:
         arr = np.array(a, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise ShapeError(
             f"{label}: {name} must be a numeric array of shape (N+1, N+1); "
             f"could not convert {type(a).__name__}: {exc}"

@@ -33,9 +33,12 @@ from typing import Any
 import numpy as np
 
 from gmuk._numba import njit
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, as_array
 from gmuk.errors import DegreeError, DomainError, NonFiniteError, ShapeError
 from gmuk.gravity._kernels import BIG, BIGI
+
+#: The most bytes :func:`legendre_4pi` allocates (as :data:`gmuk.gravity.io.MAX_ARRAY_BYTES`).
+MAX_ARRAY_BYTES = 4 * 2**30
 
 __all__ = ["legendre_4pi", "normalization_4pi"]
 
@@ -117,7 +120,7 @@ def legendre_4pi(nmax: int, t: Any) -> FloatArray:
     True
     """
     n = _check_degree(nmax, "nmax")
-    tt = np.asarray(t, dtype=np.float64)
+    tt = as_array(t, (), "t")
     if tt.ndim > 1:
         raise ShapeError(f"t must be a scalar or a 1-D array; got shape {tt.shape}")
     if not np.all(np.isfinite(tt)):
@@ -126,6 +129,12 @@ def legendre_4pi(nmax: int, t: Any) -> FloatArray:
         worst = float(np.max(np.abs(tt)))
         raise DomainError(f"t must lie in [-1, 1]; got |t| = {worst!r}")
     flat = np.atleast_1d(tt)
+    size = 8 * flat.shape[0] * (n + 1) ** 2  # refused before allocating, as the readers do
+    if size > MAX_ARRAY_BYTES:
+        raise DegreeError(
+            f"nmax = {nmax!r:.40} would need more than the limit of {MAX_ARRAY_BYTES} bytes "
+            f"for {flat.shape[0]} point(s); refused before allocating"
+        )
     out = np.zeros((flat.shape[0], n + 1, n + 1))
     for i, ti in enumerate(flat):
         _legendre_columns(n, float(ti), out[i])

@@ -661,6 +661,8 @@ def true_from_hyperbolic_scalar(H: float, e: float) -> float:
 def parabolic_from_mean_scalar(M_p: float) -> float:
     """:func:`parabolic_from_mean` for one finite float."""
     x = abs(M_p)
+    if x > 1e100:  # 3x may overflow; D = (3x)^(1/3) to a relative 3/D² < 1e-66
+        return math.copysign(float(np.cbrt(3.0) * np.cbrt(x)), M_p)
     s = np.cbrt(0.5 * (3.0 * x + math.hypot(3.0 * x, 2.0)))
     D = 3.0 * x / (s * s + 1.0 + 1.0 / (s * s))
     polished = D - (D + D**3 / 3.0 - x) / (1.0 + D * D)  # not finite past D ~ 5e102
