@@ -2,29 +2,49 @@
 
 The rule (issue #15): a public function either returns a result free of NaN and inf, or
 raises a :class:`gmuk.errors.GmukError`; anything else (a raw ``TypeError``, a numpy
-warning turned error, ``SystemExit``) fails the test. ``COUNTS`` records how many inputs
-each entry point received, reported at the end of the run (see ``conftest.py``).
+warning turned error, ``SystemExit``) fails the test, and so does a call that takes longer
+than :data:`HANG_S` seconds of wall time (a hang: the call is interrupted by ``SIGALRM``).
+``COUNTS`` records how many inputs each entry point received, ``HANGS`` the calls that
+overran, both reported at the end of the run (see ``conftest.py``).
 """
 
 from __future__ import annotations
 
 import collections
+import contextlib
 import dataclasses
 import math
 import os
+import signal
+import threading
+import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from gmuk.errors import GmukError, GmukWarning
 
 #: Inputs each entry point received in this process, by entry point.
 COUNTS: collections.Counter[str] = collections.Counter()
+
+#: Calls that overran :data:`HANG_S`, by entry point.
+HANGS: collections.Counter[str] = collections.Counter()
+
+#: A call longer than this (s of wall time) is a hang (issue #25); ``GMUK_FUZZ_HANG_S``.
+HANG_S = float(os.environ.get("GMUK_FUZZ_HANG_S", "60"))
+
+#: Failures by test and class ("raw exception", "wrong result", "hang"): under
+#: ``GMUK_FUZZ_TALLY=1`` a failing example is recorded here and the run goes on, so that
+#: one run counts every failure instead of stopping at the first (each test still fails
+#: at its end if it recorded any). Values: (input, message) of the first few.
+FAILURES: dict[tuple[str, str], list[tuple[str, str]]] = collections.defaultdict(list)
+FAILURE_COUNTS: collections.Counter[tuple[str, str]] = collections.Counter()
+TALLY = os.environ.get("GMUK_FUZZ_TALLY", "") not in ("", "0")
 
 #: Examples per test: a fast sample in the default suite, the bulk under ``-m slow``.
 #: ``GMUK_FUZZ_SCALE`` multiplies the slow counts (e.g. 0.1 for a quick look).
@@ -35,15 +55,56 @@ class Refused(Exception):
     """Stands for "the call raised a GmukError" in :func:`outcome`."""
 
 
-def outcome(entry: str, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+class Hang(BaseException):
+    """Raised into a call that overran its wall-clock budget (a BaseException, so that no
+    ``except Exception`` on the way can turn it into an ordinary outcome)."""
+
+
+@contextlib.contextmanager
+def wall_clock_guard(entry: str, seconds: float | None = None) -> Iterator[None]:
+    """Fail (and count in :data:`HANGS`) a block that runs longer than ``seconds``.
+
+    In the main thread the block is interrupted by ``SIGALRM`` (a compiled loop is
+    interrupted at its next call back into Python); elsewhere it is timed only.
+    """
+    limit = HANG_S if seconds is None else seconds
+    main = threading.current_thread() is threading.main_thread()
+    previous: Any = None
+
+    def alarm(signum: int, frame: Any) -> None:
+        raise Hang(f"{entry}: no answer after {limit:g} s")
+
+    if main:
+        previous = signal.signal(signal.SIGALRM, alarm)
+        signal.setitimer(signal.ITIMER_REAL, limit)
+    start = time.monotonic()
+    try:
+        yield
+    except Hang:
+        HANGS[entry] += 1
+        raise AssertionError(f"{entry}: a hang (over {limit:g} s)") from None
+    finally:
+        if main:
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
+            signal.signal(signal.SIGALRM, previous)
+    elapsed = time.monotonic() - start
+    if elapsed > limit:
+        HANGS[entry] += 1
+        raise AssertionError(f"{entry}: a hang ({elapsed:.1f} s, over {limit:g} s)")
+
+
+def outcome(
+    entry: str, fn: Callable[..., Any], *args: Any, hang_s: float | None = None, **kwargs: Any
+) -> Any:
     """``fn(*args, **kwargs)`` under the rule; returns the result, or :data:`REFUSED`.
 
     Every warning is an error here, so that a numpy overflow or a discarded imaginary
-    part cannot pass as success.
+    part cannot pass as success; the call is timed by :func:`wall_clock_guard`
+    (``hang_s`` seconds, default :data:`HANG_S`).
     """
     COUNTS[entry] += 1
     try:
-        with warnings.catch_warnings():
+        with wall_clock_guard(entry, hang_s), warnings.catch_warnings():
             warnings.simplefilter("error")
             warnings.simplefilter("ignore", DeprecationWarning)
             warnings.simplefilter("ignore", GmukWarning)  # gmuk's own, documented warnings
@@ -232,6 +293,10 @@ def rotations() -> st.SearchStrategy[np.ndarray]:
     """Rotation matrices, and near-misses: scaled, reflected, sheared, perturbed."""
 
     def build(w: np.ndarray, how: str, eps: float) -> np.ndarray:
+        with np.errstate(all="ignore"):  # 0·inf in a near-miss is the point, not a warning
+            return _near_rotation(w, how, eps)
+
+    def _near_rotation(w: np.ndarray, how: str, eps: float) -> np.ndarray:
         from gmuk.lie import so3
 
         R = so3.exp(w)
@@ -279,24 +344,58 @@ def poses() -> st.SearchStrategy[Any]:
 
 
 # --------------------------------------------------------------------------- test factory
+def _record(check: Callable[..., Any], kind: str, value: Any, exc: BaseException) -> None:
+    key = (getattr(check, "__name__", repr(check)), kind)
+    FAILURE_COUNTS[key] += 1
+    if len(FAILURES[key]) < 3:
+        message = f"{type(exc).__name__}: {exc}".splitlines()[0][:300]
+        FAILURES[key].append((repr(value)[:300], message))
+
+
 def fuzz_pair(
-    strategy: st.SearchStrategy[Any], check: Callable[[Any], None], *, fast: int, slow: int
+    strategy: st.SearchStrategy[Any],
+    check: Callable[[Any], None],
+    *,
+    fast: int,
+    slow: int,
+    fast_phases: bool = True,
 ) -> tuple[Callable[[], None], Callable[[], None]]:
     """Two derandomized hypothesis tests of ``check`` on ``strategy``: ``fast`` examples for
     the default suite and ``slow`` examples marked ``slow``."""
 
-    def make(n: int) -> Callable[[], None]:
+    def make(n: int, quick: bool = False) -> Callable[[], None]:
         @settings(
             derandomize=True,
             deadline=None,
             max_examples=n,
             database=None,
             suppress_health_check=list(HealthCheck),
+            # the default suite reports a failing example as found (shrinking a compiled
+            # loop's failure takes minutes); the slow suite shrinks to a minimal reproducer
+            phases=(Phase.explicit, Phase.generate) if quick else tuple(Phase),
         )
         @given(value=strategy)
         def run(value: Any) -> None:
-            check(value)
+            if not TALLY:
+                check(value)
+                return
+            try:
+                check(value)
+            except AssertionError as exc:
+                kind = "hang" if "a hang" in str(exc) else "wrong result"
+                _record(check, kind, value, exc)
+            except Exception as exc:
+                _record(check, "raw exception", value, exc)
 
-        return run
+        if not TALLY:
+            return run
 
-    return make(fast), pytest.mark.slow(make(max(1, round(slow * SLOW_SCALE))))
+        def tallied() -> None:
+            before = sum(FAILURE_COUNTS.values())
+            run()
+            found = sum(FAILURE_COUNTS.values()) - before
+            assert not found, f"{found} failing examples (see the fuzz summary)"
+
+        return tallied
+
+    return make(fast, fast_phases), pytest.mark.slow(make(max(1, round(slow * SLOW_SCALE))))
