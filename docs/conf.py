@@ -1,4 +1,5 @@
-"""Sphinx configuration for gmuk's documentation (built offline: no intersphinx)."""
+"""Sphinx configuration for gmuk's documentation (built and read offline: no intersphinx, and
+MathJax ships with the pages; tests/test_docs_offline.py renders a page with the network off)."""
 
 from __future__ import annotations
 
@@ -17,6 +18,9 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    # MathJax 3.2.2 shipped with the docs, not loaded from a CDN: the PyPI package (in the
+    # dev extra) copies its files to _static/mathjax and points mathjax_path there.
+    "sphinx-mathjax-offline",
     "sphinx.ext.viewcode",
     "gmuk_gallery",
 ]
