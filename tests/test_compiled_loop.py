@@ -1127,3 +1127,28 @@ def test_a_kernel_that_does_not_fit_its_kind_of_part_is_refused_when_the_program
     state = system.state(r={"p": [0.0, 0.0, 0.0]}, v={"p": [1.0, 0.0, 0.0]})
     with pytest.raises(DefinitionError, match="returns float64"):
         system.compiled_program(get_method("DOP853"), state)
+
+
+def test_the_rows_a_program_counts_at_the_start_are_checked_as_at_every_stage():
+    """A constraint in Python whose first rows (read to count them) hold NaN fails the run,
+    in the compiled loop as in the reference loop, though its later rows are finite."""
+
+    class NaNFirst(gmuk.Constraint):
+        def __init__(self):
+            super().__init__(["a"])
+            self.calls = [0]
+
+        def rows(self, state):
+            self.calls[0] += 1
+            if self.calls[0] == 1:
+                return np.full((1, 6), np.nan), np.zeros(1)
+            return np.eye(6)[:1], np.zeros(1)
+
+    for run in (
+        lambda s, x: s.simulate(x, (0.0, 1e-3), method="RK4", step=2.5e-4),
+        lambda s, x: reference_simulate(s, x, (0.0, 1e-3), method="RK4", step=2.5e-4),
+    ):
+        system = gmuk.System([gmuk.RigidBody("a", 1.0, np.eye(3))], [NaNFirst()])
+        state = system.state(g={"a": np.eye(4)}, V={"a": np.zeros(6)})
+        with pytest.raises(SimulationError, match="NaN or inf|not finite"):
+            run(system, state)

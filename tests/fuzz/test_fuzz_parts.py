@@ -292,6 +292,10 @@ class ControlScript(Script):
         u, z_dot = out
         if not isinstance(u, (tuple, list)) or len(u) != 1:
             return False
+        # ż may have any shape with n_states entries (a column, or 0-d for one state), as
+        # the System documents; the values must be as honest as u's
+        if isinstance(z_dot, np.ndarray) and z_dot.size == self.n_states:
+            z_dot = z_dot.reshape(-1)
         return check(u[0], (self.dof,)) and check(z_dot, (self.n_states,))
 
     def honest(self, shape=None) -> bool:

@@ -20,7 +20,7 @@ import numpy as np
 
 from gmuk._numba import kernel_address
 from gmuk.bodies import Body, BodyKind
-from gmuk.constraints.base import ROWS_KERNEL
+from gmuk.constraints.base import ROWS_KERNEL, as_rows
 from gmuk.control.base import CONTROL_KERNEL
 from gmuk.engine.integrators._base import RungeKuttaMethod
 from gmuk.engine.integrators.dop853 import DOP853
@@ -308,9 +308,11 @@ def build(view: SystemView, method: RungeKuttaMethod, state: State) -> Program:
         row = 0
         for k in range(cons.shape[0]):
             cons[k, 3] = row
-            if cons[k, 0] == PYTHON:
-                _, b = view.rows_of(view.constraints[k], state)
-                cons[k, 4] = np.asarray(b).reshape(-1).size
+            if cons[k, 0] == PYTHON:  # its rows at the start, checked as at every stage
+                c = view.constraints[k]
+                A, b = view.rows_of(c, state)
+                _, b = as_rows(A, b, view.constraint_cols[k].size, f"constraint {c.name!r}")
+                cons[k, 4] = b.size
             row += cons[k, 4]
         n_rows = int(cons[:, 4].sum())
         if solve == DENSE and n_rows > QR_MAX_ROWS:  # more than the certified QR takes
@@ -517,7 +519,6 @@ class PythonParts:
         self._state: State | None = None
         self.error: BaseException | None = None
         # resolved once: the callback runs at every evaluation
-        from gmuk.constraints.base import as_rows
         from gmuk.state import State as _State
 
         self._as_rows, self._make_state, self._pair = as_rows, _State._adopt, view.rows_of
