@@ -483,11 +483,16 @@ def figures(result: ScenarioResult, out: Path, formats: tuple[str, ...]) -> list
         panels = []
         for q, label, unit in _QUANTITIES:
             name = "max |Δ angle|" if q == "euler321_deg" else f"|Δ {label}|"
+            # Colour and marker per degree (the degree-50 curve lies close to the
+            # degree-150 one: its markers keep it visible), line style per model.
             lines = [
                 (
                     f"{m} deg {n}",
                     _norms(diffs[key])[q],
-                    {"linestyle": styles.get(m, ":"), "color": f"C{i}"},
+                    {
+                        **plotting.distinct_styles(len(group), len(t))[i],
+                        "linestyle": styles.get(m, ":"),
+                    },
                 )
                 for m, group in runs.items()
                 for i, (n, key) in enumerate(group)
