@@ -206,7 +206,10 @@ def real_number(
 
     exc = error or DefinitionError
     kind = "a number > 0" if positive else "a number >= 0" if non_negative else "a real number"
-    bad = isinstance(value, (bool, np.bool_, complex, np.complexfloating, str, bytes))
+    bad = isinstance(value, (bool, np.bool_, complex, np.complexfloating, str, bytes)) or (
+        # a 0-d array of strings, bytes, booleans or complex numbers: float() would parse it
+        isinstance(value, np.ndarray) and value.dtype.kind not in "iuf"
+    )
     try:
         bad = bad or np.ndim(value) != 0
         v = float("nan") if bad else float(value)

@@ -521,7 +521,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             from gmuk.campaign._cli import main as campaign_main
 
             return campaign_main(argv[1:])
-        args = _parser().parse_args(argv)
+        try:
+            args = _parser().parse_args(argv)
+        except SystemExit as exc:  # --help, or a subcommand's -h: printed, status 0
+            return exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 2
         if args.command == "list":
             found = scenarios.available()
             width = max([8, *(len(scenario.name) for scenario, _ in found)])

@@ -80,6 +80,10 @@ __all__ = ["CheckReport", "CheckRow", "check"]
 LIE_TOL = 1e-11
 DYNAMICS_TOL = 1e-10
 
+#: The most samples :func:`check` takes per quantity (its inputs and Pinocchio's objects
+#: are held in memory: about 1 KiB a sample).
+MAX_SAMPLES = 1_000_000
+
 #: Permutation [ω; v] ↔ [v; ω] as an index array (applied on the last axis).
 _SWAP = np.array([3, 4, 5, 0, 1, 2])
 
@@ -458,7 +462,8 @@ def check(seed: int = 0, n: int = 1000, verbose: bool = False) -> CheckReport:
     Raises
     ------
     DefinitionError
-        ``n`` or ``seed`` is not a non-negative integer (``n`` ≥ 1).
+        ``n`` or ``seed`` is not a non-negative integer (``n`` ≥ 1), or ``n`` is more than
+        :data:`MAX_SAMPLES`.
 
     Notes
     -----
@@ -469,6 +474,12 @@ def check(seed: int = 0, n: int = 1000, verbose: bool = False) -> CheckReport:
     for label, value, low in (("n", n, 1), ("seed", seed, 0)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
             raise DefinitionError(f"check: {label} must be an integer ≥ {low}; got {value!r}")
+    if n > MAX_SAMPLES:  # refused before allocating n samples (10**400 cannot be)
+        raise DefinitionError(
+            f"check: n must be at most {MAX_SAMPLES:,} (gmuk.crosscheck.MAX_SAMPLES, about "
+            f"{MAX_SAMPLES // 1000 * 0.3 / 60:.0f} min and 1 GiB); got "
+            + (f"{int(n):,}" if n < 10**20 else f"an integer of {len(str(int(n)))} digits")
+        )
     import pinocchio as pin
 
     t0 = time.perf_counter()

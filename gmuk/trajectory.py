@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray
+from gmuk._validation import FloatArray, strict_integer
 from gmuk.bodies import BodyKind
 from gmuk.errors import DefinitionError, FileFormatError
 from gmuk.lie import euler, so3
@@ -148,8 +148,15 @@ class Trajectory:
         return self.xdot[:, self._point_columns()]
 
     def state(self, i: int) -> State:
-        """The State at output ``i`` (a copy; negative indices count from the end)."""
+        """The State at output ``i`` (a copy; negative indices count from the end).
+
+        ``i`` is an output index (an integer), not a time: a string, float, bool or
+        sequence is a :class:`~gmuk.errors.DefinitionError`."""
         n = len(self)
+        what = "Trajectory.state: i (an output index, not a time)"
+        if isinstance(i, np.ndarray):  # even 0-d: an index is a number, not an array
+            raise DefinitionError(f"{what} must be an integer; got an array {i!r:.60}")
+        i = strict_integer(i, what)
         if not -n <= i < n:
             raise DefinitionError(f"output index {i} out of range for {n} outputs")
         return State(

@@ -29,6 +29,7 @@ one-orbit FCEI run, 721 outputs: 5.06 MB).
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -168,7 +169,9 @@ def view_html(
 
     allpos = np.concatenate([r[path_idx] for _, r, _ in bodies])
     size = float(np.ptp(allpos, axis=0).max()) if len(allpos) > 1 else 0.0
-    size = max(size, 2.0 * central_radius if central_radius else 0.0)
+    if central_radius:  # the diameter, at most float64's largest (a radius near 1e308)
+        central_radius = float(central_radius)
+        size = max(size, min(2.0 * central_radius, sys.float_info.max))
     size = size if size > 1e-6 else 1.0  # bodies at rest: a 1 m scene
     scale, unit = (1e-3, "km") if size > KM_ABOVE_M else (1.0, "m")
     length = triad_length if triad_length is not None else 0.12 * size
@@ -358,10 +361,11 @@ def write_view(
     ------
     DefinitionError
         ``path`` is an existing folder (``gmuk view --out DIR`` writes ``DIR/view.html``;
-        this function writes exactly the file it is given), or as :func:`view_html`.
+        this function writes exactly the file it is given), a file stands where one of its
+        folders should be, or as :func:`view_html`.
     OSError
-        The file or its folder cannot be written (permissions, a file where a folder
-        should be); ``gmuk view`` reports it as a message with exit status 2.
+        The file or its folder cannot be written (permissions); ``gmuk view`` reports it as
+        a message with exit status 2.
     """
     if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
         raise DefinitionError(f"write_view: path must be a str or a Path; got {path!r:.80}")
@@ -370,6 +374,11 @@ def write_view(
         raise DefinitionError(
             f"write_view: {str(path)!r} is a folder; give the .html file to write "
             f"(e.g. {str(path / 'view.html')!r})"
+        )
+    blocking = next((p for p in path.parents if p.exists() and not p.is_dir()), None)
+    if blocking is not None:
+        raise DefinitionError(
+            f"write_view: cannot write {str(path)!r}: {str(blocking)!r} is a file, not a folder"
         )
     path.parent.mkdir(parents=True, exist_ok=True)
     return write_text_atomic(

@@ -47,6 +47,17 @@ def _stream_key(name: str) -> int:
     return int.from_bytes(hashlib.sha256(name.encode()).digest()[:4], "little")
 
 
+def _mapping(value: Any, name: str) -> dict[Any, Any]:
+    """``value`` as a dict, refusing what is not a mapping (``fixed=1j``, a string, bytes,
+    ``...``) with a :class:`DefinitionError` instead of ``dict()``'s raw TypeError."""
+    if not isinstance(value, Mapping):
+        raise DefinitionError(
+            f"{name} must be a mapping of parameter name to value (a dict) or None; "
+            f"got {type(value).__name__} {value!r:.60}"
+        )
+    return dict(value)
+
+
 def _plain(value: Any) -> Any:
     """``value`` for JSON: tuples as lists."""
     return list(value) if isinstance(value, tuple) else value
@@ -107,9 +118,12 @@ class Campaign:
             )
         set_ = object.__setattr__
         set_(self, "model", model)
-        disp = dict(model.default_dispersions if self.dispersions is None else self.dispersions)
-        fixed = dict(self.fixed or {})
-        grid_in = dict(model.default_grid if self.grid is None else self.grid)
+        disp = _mapping(
+            model.default_dispersions if self.dispersions is None else self.dispersions,
+            "dispersions",
+        )
+        fixed = _mapping({} if self.fixed is None else self.fixed, "fixed")
+        grid_in = _mapping(model.default_grid if self.grid is None else self.grid, "grid")
         seen: dict[str, str] = {}
         for role, names in (("fixed", fixed), ("dispersions", disp), ("grid", grid_in)):
             for name in names:

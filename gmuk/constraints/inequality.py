@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import abc
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -52,7 +53,7 @@ import numpy as np
 
 from gmuk._casadi import casadi, column
 from gmuk._forms import Forms
-from gmuk._validation import FloatArray, as_array, real_number
+from gmuk._validation import NOT_REAL, FloatArray, as_array, real_number
 from gmuk.bodies import BodyKind, SlackCoordinate
 from gmuk.constraints.base import Baumgarte
 from gmuk.constraints.holonomic import Config, _Differentiable, _kinds_of, body_configs
@@ -259,21 +260,44 @@ class InequalityConstraint(_Differentiable):
     def _who(self) -> str:
         return f"inequality {self.name!r}"
 
-    def _scalar(self, v: Any, what: str) -> float:
-        arr = np.asarray(v, dtype=float) if not isinstance(v, float) else v
-        if isinstance(arr, np.ndarray):
-            if arr.size != 1:
+    def _scalar(self, v: Any, what: str, t: float) -> float:
+        """``v``, what the user's ``what`` returned at time ``t``, as a finite float.
+
+        Only real numbers pass (Python and numpy ints and floats, and arrays of one such
+        element): booleans, strings, bytes, complex numbers, None and other objects are
+        refused, never converted (``"1.0"`` would be parsed, ``True`` read as 1).
+        """
+        if type(v) is float:  # the common case: no conversion to check
+            x = v
+        else:
+            where = f"{self._who()} at t = {t!r}"
+            if isinstance(v, np.ndarray):
+                if v.size != 1:
+                    raise ConstraintError(f"{where}: {what} must be a scalar; got shape {v.shape}")
+                if v.dtype.kind not in "iufO":
+                    raise ConstraintError(
+                        f"{where}: {what} must be a real number; got an array of dtype "
+                        f"{v.dtype}: {v!r:.60}"
+                    )
+                v = v.reshape(())[()]
+            if isinstance(v, NOT_REAL) or not isinstance(v, numbers.Real):
                 raise ConstraintError(
-                    f"{self._who()}: {what} must be a scalar; got shape {arr.shape}"
+                    f"{where}: {what} must be a real number (a float); got "
+                    f"{type(v).__name__} {v!r:.60}"
                 )
-            arr = float(arr.reshape(()))
-        if not math.isfinite(arr):
-            raise ConstraintError(f"{self._who()}: {what} is not finite; got {arr!r}")
-        return arr
+            try:
+                x = float(v)
+            except OverflowError:  # an int beyond float64
+                raise ConstraintError(
+                    f"{where}: {what} is not finite; got an integer too large for float64"
+                ) from None
+        if not math.isfinite(x):
+            raise ConstraintError(f"{self._who()} at t = {t!r}: {what} is not finite; got {x!r}")
+        return x
 
     def _value(self, q: Config, nu: Config, t: float) -> float:
-        """:meth:`value`, checked to be a finite scalar."""
-        return self._scalar(self.value(q, nu, t), "value()")
+        """:meth:`value`, checked to be a finite real scalar."""
+        return self._scalar(self.value(q, nu, t), "value()", t)
 
     def _row(self, q: Config, nu: Config, t: float, n: int) -> FloatArray:
         A_h = np.asarray(self.jacobian(q, nu, t), dtype=float).reshape(-1)
@@ -311,7 +335,7 @@ class InequalityConstraint(_Differentiable):
         n = sum(v.size for v in nu)
         k = len(self._bounds)
         A_h = self._row(q, nu, t, n)
-        b_h = self._scalar(self.bias(q, nu, t), "bias()")
+        b_h = self._scalar(self.bias(q, nu, t), "bias()", t)
         A = np.zeros((k, n + k))
         A[:, :n] = A_h
         b = np.full(k, b_h)
@@ -319,7 +343,7 @@ class InequalityConstraint(_Differentiable):
         gains = self.baumgarte
         if gains is not None:
             h = self._value(q, nu, t)
-            h_dot = self._scalar(self.rate(q, nu, t), "rate()") if position else 0.0
+            h_dot = self._scalar(self.rate(q, nu, t), "rate()", t) if position else 0.0
         for i, (bd, j) in enumerate(zip(self._bounds, self._slack_indices(state), strict=True)):
             w, w_dot = float(state.x[j]), float(state.xdot[j])
             two_sigma = 2.0 * bd.sign
@@ -340,7 +364,7 @@ class InequalityConstraint(_Differentiable):
     def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
         """The residuals of the equalities ``h − bound + σw² = 0``, one per bound
         (:meth:`Constraint.violation`): at the position level (φ, φ̇); at the velocity level
-        (None, h − bound + σẇ²). Each is divided by max(1, |bound| + the size of h's own terms,
+        (None, h − bound + σẇ²). Each is divided by max(1, abs(bound) + the size of h's own terms,
         e.g. a TrackingErrorBound's bound) (in the unit of h): the
         equality balances quantities of the bound's size, and its finite-difference rows
         carry noise in proportion (a position bound of 1000 m on an orbit holds its
@@ -355,7 +379,7 @@ class InequalityConstraint(_Differentiable):
         value = np.array([bd.value for bd in self._bounds], dtype=float)
         scale = np.maximum(1.0, np.abs(value) + self._violation_scale(t))
         if self.level == "position":
-            h_dot = self._scalar(self.rate(q, nu, t), "rate()")
+            h_dot = self._scalar(self.rate(q, nu, t), "rate()", t)
             return (h - value + sign * w * w) / scale, (h_dot + 2.0 * sign * w * w_dot) / scale
         return None, (h - value + sign * w_dot * w_dot) / scale
 
@@ -402,7 +426,7 @@ class InequalityConstraint(_Differentiable):
         h = self._value(q, nu, t)
         out: list[tuple[float, float]] = []
         position = self.level == "position"
-        h_dot = self._scalar(self.rate(q, nu, t), "rate()") if position else 0.0
+        h_dot = self._scalar(self.rate(q, nu, t), "rate()", t) if position else 0.0
         for bd in self._bounds:
             margin = bd.margin(h)
             unit = f" {self.unit}" if self.unit else ""
@@ -418,7 +442,7 @@ class InequalityConstraint(_Differentiable):
             # exactly on the bound: the free motion decides whether it holds
             n = free_acceleration.size
             A_h = self._row(q, nu, t, n)
-            b_h = self._scalar(self.bias(q, nu, t), "bias()")
+            b_h = self._scalar(self.bias(q, nu, t), "bias()", t)
             free_rate = float(A_h @ free_acceleration) - b_h  # ḧ_free or ḣ_free
             if position:
                 tol = 1e-9 * max(1.0, abs(bd.value)) / self.fd_time
@@ -445,9 +469,22 @@ class InequalityConstraint(_Differentiable):
     def initial_owned_state(
         self, state: State, free_acceleration: FloatArray
     ) -> list[tuple[float, float]]:
-        """:meth:`initial_slack`, given the free acceleration of all the columns."""
+        """:meth:`initial_slack`, given the free acceleration of all the columns.
+
+        An exception of the user's own that :meth:`value` (or :meth:`jacobian`, :meth:`bias`,
+        :meth:`rate`) raises here, where :meth:`gmuk.System.state` computes the initial
+        slack, becomes a :class:`~gmuk.errors.ConstraintError` naming the constraint (the
+        original is its ``__cause__``)."""
         n = free_acceleration.size - len(self._bounds)
-        return self.initial_slack(state, free_acceleration[:n])
+        try:
+            return self.initial_slack(state, free_acceleration[:n])
+        except GmukError:
+            raise
+        except Exception as exc:
+            raise ConstraintError(
+                f"{self._who()}: computing the initial slack at t = {state.t!r} raised "
+                f"{type(exc).__name__}: {exc}"
+            ) from exc
 
     def __repr__(self) -> str:
         bounds = ", ".join(f"{b.side}={b.value:g}" for b in self._bounds)
@@ -507,6 +544,9 @@ class PlaneBound(InequalityConstraint):
             raise DefinitionError(
                 f"PlaneBound: normal must be a non-zero 3-vector; got {normal!r}"
             ) from None
+        largest = float(np.abs(n).max())
+        if largest > 0.0:  # scaled first: the norm of entries near 1e308 would overflow
+            n = n / largest
         norm = float(np.linalg.norm(n))
         if not (math.isfinite(norm) and norm > 0.0):
             raise DefinitionError(f"PlaneBound: normal must be a non-zero 3-vector; got {normal!r}")

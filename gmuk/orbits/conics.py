@@ -21,7 +21,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from gmuk._validation import FloatArray, as_array
+from gmuk._validation import FloatArray, as_array, real_number
 from gmuk.errors import OrbitError
 from gmuk.orbits import _kernels, kepler
 from gmuk.orbits.elements import (
@@ -40,6 +40,19 @@ Conic = Literal["ellipse", "parabola", "hyperbola"]
 
 def _float(x: Any, name: str) -> float:
     return float(as_array(x, (), name, batch=False))
+
+
+def one_time(t: Any, who: str) -> float:
+    """``t`` (s) as a float: a real number, never a string, bool, None or complex number
+    (a :class:`~gmuk.errors.DefinitionError` naming ``who``); NaN and ±inf pass through (an
+    integer beyond float64 as ±inf), for the caller to refuse."""
+    if type(t) is float:
+        return t
+    if isinstance(t, np.floating) or (
+        isinstance(t, np.ndarray) and t.ndim == 0 and t.dtype.kind == "f"
+    ):
+        return float(t)
+    return real_number(t, f"{who}: t (s)", allow_inf=True)
 
 
 @dataclass(frozen=True)
@@ -348,7 +361,7 @@ class KeplerOrbit:
         """Position (m), velocity (m/s) and two-body acceleration (m/s²) in N at one time t
         (s since periapsis), each of shape (3,): the scalar fast path of :meth:`position`,
         :meth:`velocity` and :meth:`acceleration` for right-hand sides that need all three."""
-        f = self._scalar_anomaly(float(t))[0]
+        f = self._scalar_anomaly(one_time(t, "KeplerOrbit.kinematics"))[0]
         c, s = math.cos(f), math.sin(f)
         r = self.p / (1.0 + self.e * c)
         k = math.sqrt(self.mu / self.p)

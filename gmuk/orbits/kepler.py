@@ -88,6 +88,7 @@ _C3 = 2.4492935982947064e-16
 _MAX_REVS = 2.0**26
 _MAX_ITER = 60
 _EPS = float(np.finfo(np.float64).eps)
+_LOG2 = math.log(2.0)
 # Newton stops once its predicted remaining error (quadratic and cubic terms of the step) is
 # below _STOP·|root|.
 _STOP = 0.05 * _EPS
@@ -636,12 +637,16 @@ def hyperbolic_from_mean_scalar(M: float, e: float) -> float:
     """:func:`hyperbolic_from_mean` for one finite float and ``e > 1`` (not checked)."""
     x = abs(M)
     em1 = e - 1.0
-    H = min(math.asinh(x / em1), _cubic_root_scalar(em1, e / 6.0, x))  # x/em1 may be inf
+    y = x / em1
+    # asinh(y) = log(2y) to double precision beyond 1e300, and in logs y may be beyond
+    # float64 (|M| near 1e308, e near 1): the bound stays finite
+    bound = math.asinh(y) if y < 1e300 else (_LOG2 + math.log(x)) - math.log(em1)
+    H = min(bound, _cubic_root_scalar(em1, e / 6.0, x))
     for _ in range(2):
         H = math.asinh((x + H) / e)
     for _ in range(_MAX_ITER):
         resid = em1 * math.sinh(H) + _sinh_minus_x_scalar(H) - x
-        deriv = em1 + 2.0 * e * math.sinh(0.5 * H) ** 2
+        deriv = em1 + e * (2.0 * math.sinh(0.5 * H) ** 2)  # 2e overflows near 1e308
         step = resid / deriv
         a_step = abs(step)
         err = 0.5 * e * (abs(math.sinh(H)) + math.cosh(H) * a_step / 3.0) * a_step * a_step

@@ -55,7 +55,7 @@ from gmuk._validation import FloatArray, as_array, check_se3
 from gmuk.errors import DefinitionError, NonFiniteError
 from gmuk.lie import se3
 from gmuk.orbits import _kernels
-from gmuk.orbits.conics import KeplerOrbit
+from gmuk.orbits.conics import KeplerOrbit, one_time
 from gmuk.reference import ReferenceState, ReferenceTrajectory
 
 __all__ = [
@@ -258,8 +258,10 @@ class LVLHReference(ReferenceTrajectory):
         ------
         NonFiniteError
             If t is NaN or infinite.
+        DefinitionError
+            If t is not a real number (None, a string, a bool, a complex number).
         """
-        t = float(t)
+        t = one_time(t, "LVLHReference.evaluate")
         last = self._last
         if last is not None and last[0] == t:
             return last[1]

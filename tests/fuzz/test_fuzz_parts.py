@@ -699,11 +699,8 @@ def test_a_part_that_raises_once_never_gives_a_successful_run():
 pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
 
 # Found by this fuzz and left to the engineers now changing the engine (issue #25, item 4):
-# the default suite marks them so that it stays green; the slow suite counts them.
+# the default suite marks it so that it stays green; the slow suite counts it.
 _ENGINE = "issue #25 item 4: parts' return values, in progress in gmuk/engine (see reliability.rst)"
 test_constraint_rows_callbacks_are_checked_in_the_compiled_loop = pytest.mark.xfail(
     reason=_ENGINE, strict=False
 )(test_constraint_rows_callbacks_are_checked_in_the_compiled_loop)
-test_inequality_constraint_values_are_checked_in_the_compiled_loop = pytest.mark.xfail(
-    reason=_ENGINE, strict=False
-)(test_inequality_constraint_values_are_checked_in_the_compiled_loop)

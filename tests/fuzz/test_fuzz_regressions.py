@@ -8,7 +8,7 @@ import pytest
 
 import gmuk
 from gmuk import orbits
-from gmuk.errors import DefinitionError, DegreeError, ShapeError
+from gmuk.errors import ConstraintError, DefinitionError, DegreeError, ShapeError
 from gmuk.gravity import SphericalHarmonicField, legendre_4pi
 from gmuk.view import decimate, view_html, write_view
 
@@ -103,3 +103,135 @@ def test_view_html_refuses_titles_and_options_of_the_wrong_type(kwargs):
 def test_write_view_refuses_a_path_that_is_not_a_str_or_path(path):
     with pytest.raises(DefinitionError, match="path must be a str or a Path"):
         write_view(_traj(), path)
+
+
+# ---------------------------------------------------------------- issue #25, second round
+class _Scripted(gmuk.InequalityConstraint):
+    """h = whatever ``make`` returns (an InequalityConstraint whose value() is hostile)."""
+
+    def __init__(self, make):
+        super().__init__(["a"], lower=-10.0, name="scripted")
+        self.make = make
+
+    def value(self, q, nu, t):
+        return self.make()
+
+
+def _bounded_point(make):
+    return gmuk.System([gmuk.PointMass("a", 1.0)], [_Scripted(make)])
+
+
+@pytest.mark.parametrize(
+    "h",
+    ["1.0", True, np.True_, b"", object(), None, 1j, np.array("1.0"), np.array(True), [1.0]],
+    ids=lambda h: "object()" if type(h) is object else repr(h),  # stable across workers
+)
+def test_inequality_value_that_is_not_a_real_number_is_refused_naming_constraint_and_time(h):
+    system = _bounded_point(lambda: h)
+    with pytest.raises(ConstraintError, match="must be a") as info:
+        system.state(r={"a": [1.0, 0, 0]}, v={"a": [0, 0, 0]})
+    assert "'scripted'" in str(info.value) and "t = 0.0" in str(info.value)
+
+
+@pytest.mark.parametrize("h", [float("nan"), -np.inf, 10**400], ids=repr)
+def test_inequality_value_that_is_not_finite_is_refused_naming_constraint_and_time(h):
+    system = _bounded_point(lambda: h)
+    with pytest.raises(ConstraintError, match="not finite") as info:
+        system.state(r={"a": [1.0, 0, 0]}, v={"a": [0, 0, 0]})
+    assert "'scripted'" in str(info.value) and "t = 0.0" in str(info.value)
+
+
+@pytest.mark.parametrize("h", [1.0, 1, np.float32(1.0), np.int64(1), np.array(1.0)], ids=repr)
+def test_inequality_value_as_any_real_number_type_gives_the_slack_of_the_float(h):
+    state = _bounded_point(lambda: h).state(r={"a": [1.0, 0, 0]}, v={"a": [0, 0, 0]})
+    assert state.x[3] == np.sqrt(11.0)
+
+
+@pytest.mark.filterwarnings("error")
+def test_plane_bound_normal_near_float_max_is_normalised_without_overflow():
+    bound = gmuk.PlaneBound("a", [1e308, 1e308, 0.0], lower=0.0)
+    np.testing.assert_allclose(bound.normal, [2**-0.5, 2**-0.5, 0.0], rtol=1e-15)
+
+
+@pytest.mark.parametrize("i", ["b0", {}, None, 0.0, True, 1j, [0], np.array(1)], ids=repr)
+def test_trajectory_state_refuses_an_index_that_is_not_an_integer(i):
+    with pytest.raises(DefinitionError, match="output index"):
+        _traj().state(i)
+
+
+def test_trajectory_state_takes_python_and_numpy_integers():
+    traj = _traj()
+    assert traj.state(np.int64(-1)).t == traj.t[-1] and traj.state(1).t == traj.t[1]
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["list", "-h"], ["check", "--help"]])
+def test_cli_help_returns_status_0_instead_of_raising_system_exit(argv, capsys):
+    from gmuk import cli
+
+    assert cli.main(argv) == 0
+    assert "usage: gmuk" in capsys.readouterr().out
+
+
+def campaign_metrics(params):
+    """A campaign function (importable by name)."""
+    return {"y": 2.0 * params["x"]}
+
+
+@pytest.mark.parametrize("role", ["fixed", "dispersions", "grid"])
+@pytest.mark.parametrize("value", [1j, Ellipsis, b"x", "x", 3], ids=repr)
+def test_campaign_refuses_fixed_dispersions_or_grid_that_are_not_mappings(role, value):
+    from gmuk.campaign import Campaign
+
+    with pytest.raises(DefinitionError, match=f"{role} must be a mapping"):
+        Campaign.from_function(campaign_metrics, {"x": 1.0}, runs=2, **{role: value})
+
+
+@pytest.mark.parametrize("n", [10**400, 10**6 + 1])
+def test_check_refuses_a_sample_count_it_cannot_allocate_before_allocating(n):
+    with pytest.raises(DefinitionError, match="n must be at most"):
+        gmuk.check(n=n)
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize(
+    ("M", "e"), [(0.2, 1e308), (0.2, 1.7976931348623157e308), (1e308, 1.0000001), (1e308, 1.5)]
+)
+def test_hyperbolic_from_mean_stays_finite_for_eccentricities_or_anomalies_near_float_max(M, e):
+    H = orbits.hyperbolic_from_mean(M, e)
+    assert np.isfinite(H) and H > 0
+    np.testing.assert_allclose(orbits.mean_from_hyperbolic(H, e), M, rtol=1e-13)
+
+
+@pytest.mark.parametrize("t", [None, "1.0", True, 1j, np.array("1.0")], ids=repr)
+def test_lvlh_reference_refuses_a_time_that_is_not_a_real_number(t):
+    ref = orbits.LVLHReference(orbits.fccn_orbit())
+    with pytest.raises(DefinitionError, match="t \\(s\\) must be a real number"):
+        ref.evaluate(t)
+
+
+def test_lvlh_reference_takes_integer_and_numpy_times_as_the_float():
+    ref = orbits.LVLHReference(orbits.fccn_orbit())
+    want = ref.evaluate(3.0).g.copy()
+    for t in (3, np.int64(3), np.float32(3.0), np.array(3.0)):
+        assert np.array_equal(ref.evaluate(t).g, want)
+
+
+@pytest.mark.parametrize("gain", [np.array("1.1"), np.array(True), np.array(1j)], ids=repr)
+def test_morse_lyapunov_refuses_a_0d_array_of_strings_booleans_or_complex_numbers(gain):
+    body = gmuk.RigidBody("sc", 1.0, np.eye(3))
+    ref = orbits.LVLHReference(orbits.fccn_orbit())
+    with pytest.raises(DefinitionError, match="k11 must be a"):
+        gmuk.MorseLyapunovController(body, ref, k11=gain)
+
+
+@pytest.mark.filterwarnings("error")
+def test_view_html_draws_a_central_body_of_radius_near_float_max_without_overflow():
+    page = view_html(_traj(), central_radius=1e308)
+    assert page.count("</html>") == 1
+
+
+def test_write_view_refuses_a_path_under_a_regular_file(tmp_path):
+    (tmp_path / "f").write_text("not a folder")
+    with pytest.raises(DefinitionError, match="is a file, not a folder"):
+        write_view(_traj(), tmp_path / "f" / "view.html")
+    assert (tmp_path / "f").read_text() == "not a folder"

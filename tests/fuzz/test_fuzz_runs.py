@@ -616,15 +616,3 @@ def check_cli_misc(argv) -> None:
 
 
 pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
-
-# Found by this fuzz, listed in docs/reliability.rst and left to the owners of the code
-# (gmuk/trajectory.py, gmuk/cli.py and gmuk/campaign are being changed now): the default
-# suite marks them so that it stays green; the slow suite counts them.
-for _name, _why in (
-    ("test_trajectory_accessors_take_indices_names_and_sequences", "Trajectory.state('b0')"),
-    ("test_campaigns_of_a_function_record_every_run_once_and_repeat_bit_for_bit", "fixed=..."),
-    ("test_cli_subcommands_exit_with_a_status_and_never_raise", "gmuk --help: SystemExit(0)"),
-):
-    globals()[_name] = pytest.mark.xfail(reason=f"issue #25 fuzz: {_why}", strict=False)(
-        globals()[_name]
-    )
