@@ -9,6 +9,20 @@ Eq. 80 for ``g̈_c`` and recovers ``V̇_c,i = (g_i⁻¹ g̈_c,ii)^∨``. Errata 
 for general A, B the g̈_c of Eq. 80 need not lie in g·se(3) (no control input produces it);
 gmuk projects each diagonal block onto se(3) (skew rotation part, translation column) and
 reports the size of what it discarded.
+
+Stabilisation (beyond the thesis). Eq. 79 holds the constraint at the acceleration level only:
+round-off and integration error that leave the constraint manifold stay off it, and grow where
+the constrained motion is unstable (the LVLH attitude of docs/scenarios/chapter4.rst). With
+``baumgarte=Baumgarte(alpha, beta)`` the constraints below add Baumgarte terms (McCann 2020,
+Eq. 4) to C, and only to C: A and B are those of the thesis, and without ``baumgarte`` (the
+default) C is too. For a tracking block ``g = g_d`` the terms act on the position-level
+constraint Φ = g − g_d itself, in the 4×4 matrices of Eq. 79: ``Φ̈ + α Φ̇ + β Φ = 0``, i.e.
+``g̈ = g̈_d − α (ġ − ġ_d) − β (g − g_d)``. Its translation column is the inertial error
+``p̈ − p̈_d + α(ṗ − ṗ_d) + β(p − p_d) = 0`` exactly; its rotation block, projected onto the
+reachable ``R (ω̇^ + ω^²)``, restores ``R_dᵀR`` through ``skew(Rᵀ R_d)`` (≈ −θ^ near the
+reference). Off the constraint the stabilised C is not reachable to second order in the error
+(the symmetric part of ``Rᵀ(R − R_d)`` is ``O(θ²)``): negligible while the terms keep the error
+at round-off.
 """
 
 from __future__ import annotations
@@ -21,11 +35,11 @@ import numpy as np
 from gmuk._forms import Forms
 from gmuk._validation import FloatArray
 from gmuk.bodies import BodyKind
-from gmuk.constraints.base import Constraint
+from gmuk.constraints.base import Baumgarte, Constraint
 from gmuk.engine.uk import reachable_rows
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3
-from gmuk.reference import ReferenceTrajectory
+from gmuk.reference import ReferenceState, ReferenceTrajectory
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body
@@ -63,17 +77,63 @@ class TangentBundleConstraint(Constraint):
         return reachable_rows(A, B, C, state.g[idx], state.V[idx])
 
 
+def _scalar_gains(baumgarte: Baumgarte | None, owner: str, label: str) -> tuple[float, float]:
+    """(α, β) of ``baumgarte`` as floats (0, 0 for None); the T² terms take scalar gains."""
+    if baumgarte is None:
+        return 0.0, 0.0
+    if not isinstance(baumgarte, Baumgarte):
+        raise DefinitionError(
+            f"{label} of a {owner} must be a gmuk.Baumgarte or None; got {type(baumgarte).__name__}"
+        )
+    alpha, beta = np.asarray(baumgarte.alpha), np.asarray(baumgarte.beta)
+    if alpha.ndim or beta.ndim:
+        raise DefinitionError(
+            f"the {label} gains of a {owner} must be scalars (one α and one β for all the "
+            f"entries of its 4×4 blocks); got alpha {alpha.shape}, beta {beta.shape}"
+        )
+    return float(alpha), float(beta)
+
+
+def _tracking_target(
+    g: FloatArray, V: FloatArray, ref: ReferenceState, gains: tuple[float, float] = (0.0, 0.0)
+) -> FloatArray:
+    """The g̈ that tracking ``g = g_d`` asks for: ``g̈_d = g_d (V_d^² + V̇_d^)`` (Eq. 79's C for
+    A = B = I₄), minus ``α (ġ − ġ_d) + β (g − g_d)`` when the gains ``(α, β)`` are not zero.
+
+    Parameters
+    ----------
+    g : ndarray (4, 4)
+        The pose.
+    V : ndarray (6,)
+        Its body twist.
+    ref : ReferenceState
+        (g_d, V_d, V̇_d) at the time.
+    gains : (float, float)
+        α (1/s), β (1/s²).
+    """
+    Vd = se3._hat(ref.V)
+    target: FloatArray = ref.g @ (Vd @ Vd + se3._hat(ref.V_dot))
+    alpha, beta = gains
+    if alpha or beta:
+        target = target - alpha * (g @ se3._hat(V) - ref.g @ Vd) - beta * (g - ref.g)
+    return target
+
+
 class ConfigurationTrackingT2(TangentBundleConstraint):
     """Full tracking ``g̈ = g̈_d`` on T²SE(3): A = B = I₄, C = g_d (V_d^² + V̇_d^).
 
     Equal (to round-off) to :class:`gmuk.constraints.ConfigurationTracking` on R⁶
-    (McCann 2020, Section 4.2, FCEIM).
+    (McCann 2020, Section 4.2, FCEIM). The stabilised variants differ off the reference:
+    R⁶'s Baumgarte terms act on the body-frame errors, these on g − g_d.
 
     Parameters
     ----------
     body : Body or str
         A rigid body.
     reference : ReferenceTrajectory
+    baumgarte : Baumgarte, optional
+        Scalar gains (α, β): the stabilised variant ``C = g̈_d − α (ġ − ġ_d) − β (g − g_d)``,
+        Eq. 4 on Φ = g − g_d (module docstring). None (the default): the thesis's rows.
     name : str, optional
     """
 
@@ -84,7 +144,12 @@ class ConfigurationTrackingT2(TangentBundleConstraint):
     )
 
     def __init__(
-        self, body: Body | str, reference: ReferenceTrajectory, *, name: str | None = None
+        self,
+        body: Body | str,
+        reference: ReferenceTrajectory,
+        *,
+        baumgarte: Baumgarte | None = None,
+        name: str | None = None,
     ) -> None:
         super().__init__([body], name=name)
         if not isinstance(reference, ReferenceTrajectory):
@@ -92,6 +157,8 @@ class ConfigurationTrackingT2(TangentBundleConstraint):
                 f"reference must be a gmuk.ReferenceTrajectory; got {type(reference).__name__}"
             )
         self.reference = reference
+        self._gains = _scalar_gains(baumgarte, type(self).__name__, "baumgarte")
+        self.baumgarte = baumgarte
 
     def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
         """(e_g, e_V) against the reference, weighed as for
@@ -103,10 +170,10 @@ class ConfigurationTrackingT2(TangentBundleConstraint):
         return relative_errors(state.g[i], state.V[i], ref.g, ref.V)
 
     def tangent_rows(self, state: State) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """A = B = I₄ and C = g̈_d."""
+        """A = B = I₄ and C = g̈_d (with ``baumgarte``: minus α (ġ − ġ_d) + β (g − g_d))."""
+        (i,) = self._rigid_indices(state)
         ref = self.reference.evaluate(state.t)
-        Vd = se3._hat(ref.V)
-        return np.eye(4), np.eye(4), ref.g @ (Vd @ Vd + se3._hat(ref.V_dot))
+        return np.eye(4), np.eye(4), _tracking_target(state.g[i], state.V[i], ref, self._gains)
 
 
 _X = np.eye(4)[:3]  # rows 1–3: drop the (zero) last row of g̈
@@ -132,6 +199,13 @@ class VirtualPairT2(TangentBundleConstraint):
 
     (the off-diagonal blocks of C repeat the first constraint, as A g̈ B produces them).
 
+    Stabilised variant (beyond the thesis; A and B unchanged): ``baumgarte`` replaces g̈_d in
+    every block of C by the tracking target ``g̈_d − α (ġ_L − ġ_d) − β (g_L − g_d)``
+    (:class:`ConfigurationTrackingT2`), and ``relative_baumgarte`` adds
+    ``−X g_B (α_r V_rel + β_r log h)^ Y`` to the last block, so that the five locked
+    components of the relative motion obey ``V̇_rel + α_r V_rel + β_r log h = 0`` (the roll
+    component drops out: ``X g_B e₁^ Y = 0``). With both None (the default) C is the thesis's.
+
     Parameters
     ----------
     body : Body or str
@@ -139,6 +213,11 @@ class VirtualPairT2(TangentBundleConstraint):
     relative_to : Body or str
         The virtual body L that tracks ``reference``.
     reference : ReferenceTrajectory
+    baumgarte : Baumgarte, optional
+        Scalar gains of L's tracking.
+    relative_baumgarte : Baumgarte, optional
+        Scalar gains of the lock of B to L (α_r alone: the velocity-level terms of
+        :class:`gmuk.RelativeConstraint`).
     name : str, optional
     """
 
@@ -154,6 +233,8 @@ class VirtualPairT2(TangentBundleConstraint):
         relative_to: Body | str,
         reference: ReferenceTrajectory,
         *,
+        baumgarte: Baumgarte | None = None,
+        relative_baumgarte: Baumgarte | None = None,
         name: str | None = None,
     ) -> None:
         super().__init__([relative_to, body], name=name)
@@ -162,6 +243,11 @@ class VirtualPairT2(TangentBundleConstraint):
                 f"reference must be a gmuk.ReferenceTrajectory; got {type(reference).__name__}"
             )
         self.reference = reference
+        owner = type(self).__name__
+        self._gains = _scalar_gains(baumgarte, owner, "baumgarte")
+        self._relative_gains = _scalar_gains(relative_baumgarte, owner, "relative_baumgarte")
+        self.baumgarte = baumgarte
+        self.relative_baumgarte = relative_baumgarte
 
     def violation(self, state: State) -> tuple[FloatArray | None, FloatArray | None]:
         """L's tracking errors (e_g, e_V) against the reference followed by the five locked
@@ -187,20 +273,23 @@ class VirtualPairT2(TangentBundleConstraint):
         L, Bd = self.bodies
         g_L, V_L, g_B, V_B = state.pose(L), state.twist(L), state.pose(Bd), state.twist(Bd)
         ref = self.reference.evaluate(state.t)
-        Vd = se3._hat(ref.V)
-        gdd_d = ref.g @ (Vd @ Vd + se3._hat(ref.V_dot))
+        gdd_d = _tracking_target(g_L, V_L, ref, self._gains)
         h = se3._inverse(g_L) @ g_B
         V_rel = V_B - se3._Ad(se3._inverse(h)) @ V_L
         Vr = se3._hat(V_rel)
         gL_dot = g_L @ se3._hat(V_L)
         h_dot = h @ Vr
+        lock = 2.0 * gL_dot @ h_dot + g_L @ h @ Vr @ Vr
+        alpha, beta = self._relative_gains
+        if alpha or beta:
+            lock = lock - g_B @ se3._hat(alpha * V_rel + beta * se3.log(h))
         Z = np.zeros((4, 4))
         A = np.block([[np.eye(4), Z], [-_X, _X]])
         B = np.block([[np.eye(4), h @ _Y], [Z, _Y]])
         C = np.block(
             [
                 [gdd_d, gdd_d @ h @ _Y],
-                [-_X @ gdd_d, _X @ (2.0 * gL_dot @ h_dot + g_L @ h @ Vr @ Vr) @ _Y],
+                [-_X @ gdd_d, _X @ lock @ _Y],
             ]
         )
         return A, B, C

@@ -96,13 +96,15 @@ def fully_constrained(
     tangent: bool = False,
     baumgarte: gmuk.Baumgarte | None = TRACKING_BAUMGARTE,
 ) -> Trajectory:
-    """One spacecraft tracking the modified-LVLH reference: R⁶ (Eq. 67, with ``baumgarte``
-    terms, :data:`TRACKING_BAUMGARTE` by default; None for the thesis's bare rows) or
-    T²SE(3) (Eq. 80, whose rows take no Baumgarte terms: the drift check flags its long runs)."""
+    """One spacecraft tracking the modified-LVLH reference: R⁶ (Eq. 67) or, with ``tangent``,
+    T²SE(3) (Eq. 79, A = B = I₄), with ``baumgarte`` terms (:data:`TRACKING_BAUMGARTE` by
+    default; None for the thesis's bare rows). On T²SE(3) the terms are those of the
+    stabilised :class:`gmuk.ConfigurationTrackingT2`, ``C = g̈_d − α (ġ − ġ_d) − β (g − g_d)``
+    (A and B unchanged)."""
     sc = spacecraft()
     ref = LVLHReference(orbit)
     con: gmuk.Constraint = (
-        gmuk.ConfigurationTrackingT2(sc, ref)
+        gmuk.ConfigurationTrackingT2(sc, ref, baumgarte=baumgarte)
         if tangent
         else gmuk.ConfigurationTracking(sc, ref, baumgarte=baumgarte)
     )
