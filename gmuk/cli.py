@@ -1,5 +1,6 @@
 """The ``gmuk`` command: list and run the scenarios, check gmuk against Pinocchio.
 
+    gmuk --version
     gmuk list
     gmuk plugins
     gmuk run [NAME] [--out DIR] [--no-plots] [--format FMT] [--checkpoint-every S] [options]
@@ -90,6 +91,12 @@ def _parser() -> argparse.ArgumentParser:
     p = _Parser(
         prog="gmuk", description="List and run the scenarios; check gmuk against Pinocchio."
     )
+    p.add_argument(
+        "--version",
+        action="version",
+        version=_version_line(),
+        help="print gmuk's version (and numba's, numpy's) and exit",
+    )
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.add_parser("list", help="list the scenarios with one-line descriptions")
     sub.add_parser("plugins", help="list the installed force models (gmuk's and plugins')")
@@ -124,6 +131,23 @@ def _parser() -> argparse.ArgumentParser:
         add_help=False,
     )
     return p
+
+
+def _version_line() -> str:
+    """``gmuk --version``'s line: gmuk's version and the libraries' that compute a run."""
+    v = versions()
+    return f"gmuk {v['gmuk']} (numba {v['numba']}, numpy {v['numpy']})"
+
+
+def _plugins_table() -> list[str]:
+    """``gmuk plugins``' lines: a header, then one row per installed force model, each column
+    as wide as its longest entry (so a long name never pushes the next column out of line)."""
+    from gmuk.forces import registry
+
+    header = ("NAME", "SOURCE", "CLASS")
+    rows = [(i.name, i.source, i.target) for i in registry.available()]
+    widths = [max(len(row[k]) for row in [header, *rows]) for k in range(2)]
+    return [f"{a:<{widths[0]}}  {b:<{widths[1]}}  {c}" for a, b, c in [header, *rows]]
 
 
 def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
@@ -521,10 +545,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             from gmuk.campaign._cli import main as campaign_main
 
             return campaign_main(argv[1:])
-        try:
-            args = _parser().parse_args(argv)
-        except SystemExit as exc:  # --help, or a subcommand's -h: printed, status 0
-            return exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 2
+        args = _parser().parse_args(argv)
         if args.command == "list":
             found = scenarios.available()
             width = max([8, *(len(scenario.name) for scenario, _ in found)])
@@ -548,10 +569,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"the step loop {done} ({time.perf_counter() - start:.1f} s)")
             return 0
         if args.command == "plugins":
-            from gmuk.forces import registry
-
-            for info in registry.available():
-                print(f"{info.name:<22} {info.source:<16} {info.target}")
+            print("\n".join(_plugins_table()))
             return 0
         _parser().print_help()
         return 2
@@ -561,6 +579,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:  # a signal outside the integration: nothing was computed yet
         print("gmuk: interrupted", file=sys.stderr)
         return EXIT_STATUS[signal.SIGINT]
+    except SystemExit as exc:  # --help or -h (of gmuk or a subcommand): printed, status 0
+        return exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 2
 
 
 if __name__ == "__main__":

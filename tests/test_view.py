@@ -7,7 +7,6 @@ import base64
 import html.parser
 import json
 import re
-import shutil
 import subprocess
 import tempfile
 from pathlib import Path
@@ -181,8 +180,9 @@ def test_plot_orbit_3d_writes_the_figure(tmp_path):
 
 
 # --- headless Chromium ---------------------------------------------------------------------------
+# The `chromium` fixture (tests/conftest.py) gives its path, or skips naming the apt-get command
+# that installs it (fails instead under GMUK_REQUIRE_CHROMIUM=1, which .ci/run sets).
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 FLAGS = (
     "--headless",
     "--no-sandbox",
@@ -198,17 +198,17 @@ FLAGS = (
 )
 
 
-def render(html_path: Path, png: Path) -> tuple[np.ndarray, list[str]]:
-    """Screenshot (H, W, 3) of the page, and the URLs of the requests the page made
-    (from Chromium's network log; the browser's own service requests are not the page's)."""
+def render(chromium: str, html_path: Path, png: Path) -> tuple[np.ndarray, list[str]]:
+    """Screenshot (H, W, 3) of the page by the browser ``chromium``, and the URLs of the
+    requests the page made (from Chromium's network log; the browser's own service requests
+    are not the page's)."""
     from PIL import Image
 
-    assert CHROMIUM, "Debian's chromium is needed: apt-get install -y chromium (see .ci/run)"
     with tempfile.TemporaryDirectory() as profile:
         log = Path(profile) / "net.json"
         subprocess.run(
             [
-                CHROMIUM,
+                chromium,
                 *FLAGS,
                 f"--user-data-dir={profile}/p",
                 f"--log-net-log={log}",
@@ -242,12 +242,12 @@ def sphere_pixels(image: np.ndarray) -> int:
     return int((grey & (level > 90) & (level < 210)).sum())
 
 
-def test_chromium_renders_the_view_offline_and_shows_the_moon(tmp_path):
+def test_chromium_renders_the_view_offline_and_shows_the_moon(chromium, tmp_path):
     traj = orbit_trajectory(n=300)
     with_moon = write_view(traj, tmp_path / "moon.html", central_radius=MOON_RADIUS)
     without = write_view(traj, tmp_path / "bare.html")
-    image, requests = render(with_moon, tmp_path / "moon.png")
-    bare, bare_requests = render(without, tmp_path / "bare.png")
+    image, requests = render(chromium, with_moon, tmp_path / "moon.png")
+    bare, bare_requests = render(chromium, without, tmp_path / "bare.png")
     assert requests == [] and bare_requests == []
     # not blank: a white page has no spread; the rendered scene has lines, text, shading
     assert image.std() > 15 and (image.mean(axis=2) < 200).mean() > 0.03
@@ -259,11 +259,11 @@ def test_chromium_renders_the_view_offline_and_shows_the_moon(tmp_path):
         assert (np.abs(image - colour).max(axis=2) < 30).sum() > 20, colour
 
 
-def test_the_network_log_catches_a_page_that_fetches(tmp_path):
+def test_the_network_log_catches_a_page_that_fetches(chromium, tmp_path):
     """The check above can fail: a page loading an image from a server is seen making it."""
     page = tmp_path / "fetching.html"
     page.write_text('<html><body><img src="http://127.0.0.1:9/x.png"></body></html>')
-    _, requests = render(page, tmp_path / "fetching.png")
+    _, requests = render(chromium, page, tmp_path / "fetching.png")
     assert requests == ["http://127.0.0.1:9/x.png"]
 
 

@@ -405,7 +405,9 @@ def simulate(
             traj = rec.build(status, message, loop.stats())
             bar.close()
             loop.save_checkpoint(traj)
-            raise SimulationError(message, check_drift(system, traj, drift_tol)) from exc
+            # the loop's own failure says all in the message: no chained traceback of it
+            cause = None if _own_failure(exc) else exc
+            raise SimulationError(message, check_drift(system, traj, drift_tol)) from cause
     finally:
         bar.close()
     traj = rec.build(status, message, loop.stats())
@@ -521,10 +523,24 @@ def _constraint_drift(con: Any, states: list[State], tol: float | None) -> dict[
     }
 
 
+def _loop_failure(message: str) -> SimulationError:
+    """One of the loop's own failures (step-size underflow, too many steps, a non-finite
+    derivative): a public :class:`SimulationError` marked as the loop's, so that a user never
+    meets a private class name in a message or traceback."""
+    exc = SimulationError(message)
+    exc._gmuk_loop_failure = True  # type: ignore[attr-defined]
+    return exc
+
+
+def _own_failure(exc: BaseException) -> bool:
+    """Whether ``exc`` is one of the loop's own failures (:func:`_loop_failure`)."""
+    return getattr(exc, "_gmuk_loop_failure", False) is True
+
+
 def _describe(exc: BaseException) -> str:
     """A failure's reason: the loop's own failures by their message, a part's error with its
     type."""
-    if isinstance(exc, _LoopFailure):
+    if _own_failure(exc):
         return str(exc)
     return f"{type(exc).__name__}: {exc}"
 
@@ -637,11 +653,6 @@ def check_run(
 
 class _StopRequested(Exception):
     """The run's RunControl asked the simulation to stop (gmuk.runs)."""
-
-
-class _LoopFailure(GmukError, RuntimeError):
-    """The loop's own failures: step-size underflow, too many steps, a non-finite
-    derivative (the message says which)."""
 
 
 def versions() -> dict[str, str]:
@@ -831,14 +842,14 @@ class _Loop:
             error, prog.python.error = prog.python.error, None
             if error is not None:
                 return error
-            return _LoopFailure(f"a part evaluated in Python failed at t = {t_bad:.9g} s")
+            return _loop_failure(f"a part evaluated in Python failed at t = {t_bad:.9g} s")
         if status == _compiled.UNDERFLOW:
-            return _LoopFailure(f"step size underflow (h = {float(fs[_compiled.F_H]):.3g} s)")
+            return _loop_failure(f"step size underflow (h = {float(fs[_compiled.F_H]):.3g} s)")
         if status == _compiled.MAX_STEPS:
-            return _LoopFailure(f"reached max_steps = {self.run_args.max_steps}")
+            return _loop_failure(f"reached max_steps = {self.run_args.max_steps}")
         if status == _compiled.FIELD:
             return self._field_failure(prog, t_bad, int(ints[_compiled.I_FIELD]))
-        return _LoopFailure(f"non-finite derivative at t = {t_bad:.9g} s")
+        return _loop_failure(f"non-finite derivative at t = {t_bad:.9g} s")
 
     def _field_failure(self, prog: _program.Program, t_bad: float, code: int) -> BaseException:
         """A compiled force kernel's failure, described by the model that failed: the
@@ -848,7 +859,7 @@ class _Loop:
             self.p.system.accelerations(prog.python.state())
         except Exception as exc:  # the model's own description
             return exc
-        return _LoopFailure(
+        return _loop_failure(
             f"a compiled part's kernel failed (status {code}) at t = {t_bad:.9g} s; its Python "
             "form raised nothing there (a field evaluated inside its body, or a kernel the "
             "loop does not know?)"
