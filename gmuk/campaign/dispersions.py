@@ -78,9 +78,12 @@ def _real(value: Any, label: str, owner: str) -> float:
         value, (int, float, np.integer, np.floating)
     ):
         raise DefinitionError(f"{owner}: {label} must be a real number; got {value!r}")
-    out = float(value)
+    try:
+        out = float(value)
+    except OverflowError:  # an integer beyond float64
+        out = math.inf
     if not math.isfinite(out):
-        raise DefinitionError(f"{owner}: {label} must be finite; got {value!r}")
+        raise DefinitionError(f"{owner}: {label} must be finite; got {value!r:.60}")
     return out
 
 

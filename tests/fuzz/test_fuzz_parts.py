@@ -539,8 +539,11 @@ def check_plane_bound(args) -> None:
     lo = -math.inf if lower is None else float(lower)
     hi = math.inf if upper is None else float(upper)
     moderate = max(abs(x) for x in (lo, hi, 0.0) if math.isfinite(x)) < 1e6
+    # on a bound and moving (v = 0.3 along x): a slack of 0 needs dh/dt = 0, so the start is
+    # refused (initial_slack: "start inside the bound by any margin")
+    moving_on_bound = h0 in (lo, hi) and abs(0.3 * n_hat[0]) > 1e-9 * max(1.0, abs(h0))
     if state is REFUSED:  # only an infeasible start, or bounds so large that w² overflows
-        assert not (lo <= h0 <= hi) or not moderate, (
+        assert not (lo <= h0 <= hi) or not moderate or moving_on_bound, (
             f"{entry}: refused a feasible start h0={h0} in [{lo}, {hi}]"
         )
         return

@@ -235,3 +235,20 @@ def test_write_view_refuses_a_path_under_a_regular_file(tmp_path):
     with pytest.raises(DefinitionError, match="is a file, not a folder"):
         write_view(_traj(), tmp_path / "f" / "view.html")
     assert (tmp_path / "f").read_text() == "not a folder"
+
+
+@pytest.mark.parametrize("argv", [["run", "-h"], ["run", "-h", "check"]])
+def test_cli_run_help_returns_status_0_instead_of_raising_system_exit(argv, capsys):
+    from gmuk import cli
+
+    assert cli.main(argv) == 0
+    assert "usage:" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args", [(10**400, 1.0), (0.0, -(10**400))])
+@pytest.mark.parametrize("kind", ["Normal", "Uniform"])
+def test_campaign_dispersions_refuse_integers_beyond_float64(kind, args):
+    from gmuk import campaign
+
+    with pytest.raises(DefinitionError, match="must be finite"):
+        getattr(campaign, kind)(*args)
