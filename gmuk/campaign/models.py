@@ -55,6 +55,14 @@ __all__ = [
 ]
 
 
+def _as_float(value: Any) -> float:
+    """``float(value)``, or ±inf for an integer beyond float64 (refused as not finite)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
 @dataclass(frozen=True)
 class Parameter:
     """A parameter of a campaign model.
@@ -118,19 +126,21 @@ class Parameter:
             if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
                 raise DefinitionError(f"{what} must be an integer; got {value!r}")
             out: Any = int(value)
-            comps = [float(out)]
+            comps = [_as_float(out)]
         elif self.kind == "real":
             if isinstance(value, (bool, np.bool_, str, bytes)) or not isinstance(
                 value, (int, float, np.integer, np.floating)
             ):
                 raise DefinitionError(f"{what} must be a real number; got {value!r}")
-            out = float(value)
+            out = _as_float(value)
             comps = [out]
         else:
             try:
                 arr = np.asarray(value, dtype=float)
             except (TypeError, ValueError):
                 arr = np.zeros(0)
+            except OverflowError:  # an integer beyond float64
+                raise DefinitionError(f"{what} must be finite; got {value!r:.80}") from None
             if arr.shape != (3,) or isinstance(value, (str, bytes)):
                 raise DefinitionError(f"{what} must be three real numbers; got {value!r}")
             out = (float(arr[0]), float(arr[1]), float(arr[2]))
@@ -141,7 +151,7 @@ class Parameter:
                     f"{float(np.linalg.norm(arr))!r} rad"
                 )
         if not all(math.isfinite(c) for c in ([*comps, *np.ravel(out)])):
-            raise DefinitionError(f"{what} must be finite; got {value!r}")
+            raise DefinitionError(f"{what} must be finite; got {value!r:.80}")
         bad = [c for c in comps if not self._inside(c)]
         if bad:
             raise DefinitionError(f"{what} must be {self.domain()} ({self.help}); got {value!r}")

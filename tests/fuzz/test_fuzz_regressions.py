@@ -252,3 +252,18 @@ def test_campaign_dispersions_refuse_integers_beyond_float64(kind, args):
 
     with pytest.raises(DefinitionError, match="must be finite"):
         getattr(campaign, kind)(*args)
+
+
+@pytest.mark.parametrize(
+    ("name", "value"), [("x", 10**400), ("x", -(10**400)), ("n", 10**400), ("v", (10**400, 0, 0))]
+)
+def test_campaign_parameter_values_beyond_float64_are_refused_as_not_finite(name, value):
+    from gmuk.campaign import Campaign, Parameter
+
+    params = {
+        "x": 1.0,
+        "n": Parameter("n", "integer", 3, "an integer", low=0, high=100),
+        "v": (1.0, 0.0, 0.0),
+    }
+    with pytest.raises(DefinitionError, match="must be finite"):
+        Campaign.from_function(campaign_metrics, params, runs=2, fixed={name: value})
