@@ -367,7 +367,7 @@ MAX_BYTES = 2**30
 MAX_COMPRESSION_RATIO = 1100
 #: Most bytes of the JSON metadata member.
 MAX_META_BYTES = 64 * 2**20
-#: Tolerance of the rotation checks on the saved poses: ‖RᵀR − I‖_max, |det R − 1| and the
+#: Tolerance of the rotation checks on the saved poses: ‖RᵀR − I‖_max, abs(det R − 1) and the
 #: bottom row's distance to [0, 0, 0, 1]. gmuk's integrator keeps R on SO(3) to round-off
 #: (about 1e-15 per step); a looser bound than :data:`gmuk._validation.GROUP_TOL` lets
 #: files from other programs that store fewer digits load.
@@ -436,7 +436,7 @@ def load_trajectory(path: str | Path, *, max_bytes: int = MAX_BYTES) -> Trajecto
           wrong type;
         * *arrays*: shapes that disagree with the bodies or with each other; NaN or
           infinity; times ``t`` that do not strictly increase; poses whose rotation
-          block is not a rotation (‖RᵀR − I‖ or |det R − 1| above :data:`POSE_TOL`, a
+          block is not a rotation (‖RᵀR − I‖ or abs(det R − 1) above :data:`POSE_TOL`, a
           reflection included) or whose bottom row is not [0, 0, 0, 1]; a negative
           ``residual``; a ``rank`` outside [−1, n_dof]; ``r_N``/``v_N`` that are not
           the point masses' columns of ``x``/``xdot`` (or absent from a version-2 file).

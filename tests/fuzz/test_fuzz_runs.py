@@ -14,6 +14,7 @@ that never carries a ``</script>`` it was given; ``gmuk`` exits 0, 1 or 2 and ne
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import io
 import itertools
@@ -439,7 +440,8 @@ def check_write_view(target) -> None:
     path = target(_fresh()) if callable(target) else target
     if isinstance(path, str):  # a relative junk name: under the fuzz's folder, not the cwd
         path = str(_fresh() / path) if path.strip("./") else path
-    out = outcome("view.write_view", write_view, _traj(), path)
+    with contextlib.chdir(_fresh()):  # whatever stays relative lands there, not in the cwd
+        out = outcome("view.write_view", write_view, _traj(), path)
     if out is REFUSED:
         return
     assert out.is_file() and out.read_text(encoding="utf-8").count("</html>") == 1
