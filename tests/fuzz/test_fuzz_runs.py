@@ -440,7 +440,9 @@ def check_write_view(target) -> None:
     path = target(_fresh()) if callable(target) else target
     if isinstance(path, str):  # a relative junk name: under the fuzz's folder, not the cwd
         path = str(_fresh() / path) if path.strip("./") else path
-    with contextlib.chdir(_fresh()):  # whatever stays relative lands there, not in the cwd
+    here = _fresh()
+    here.mkdir()
+    with contextlib.chdir(here):  # whatever stays relative lands there, not in the cwd
         out = outcome("view.write_view", write_view, _traj(), path)
     if out is REFUSED:
         return
