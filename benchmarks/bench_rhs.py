@@ -37,10 +37,10 @@ from typing import Any
 import numpy as np
 
 import gmuk
-from gmuk.testing import _ReferenceProblem as _Problem
 from gmuk.orbits import KeplerOrbit, LVLHReference, fcei_orbit
 from gmuk.scenarios import _lvlh as common
 from gmuk.scenarios import fcei
+from gmuk.testing import _ReferenceProblem as _Problem
 
 
 def per_call_us(fn, number: int = 5000, repeat: int = 7) -> float:

@@ -1150,5 +1150,5 @@ def test_the_rows_a_program_counts_at_the_start_are_checked_as_at_every_stage():
     ):
         system = gmuk.System([gmuk.RigidBody("a", 1.0, np.eye(3))], [NaNFirst()])
         state = system.state(g={"a": np.eye(4)}, V={"a": np.zeros(6)})
-        with pytest.raises(SimulationError, match="NaN or inf|not finite"):
+        with pytest.raises(SimulationError, match=r"NaN or inf|not finite"):
             run(system, state)
