@@ -111,12 +111,20 @@ class _ReferenceProblem(_Packing):
         """dY/dt at (t, Y) about ``G0``: the method's ``f``. The System's accelerations of
         the latest call are kept in ``acc`` (the step end records them)."""
         self.n_rhs += 1
-        # the System's unchecked entry: simulate checked the layout once, and dY is checked
-        # for NaN and inf below (System.accelerations would check the results a second time)
+        # the System's unchecked entry: simulate checked the layout once, and dY and the
+        # outputs are checked for NaN and inf below, as the compiled loop checks them
         self.acc = acc = self.system._accelerations(self.state(t, Y, self.G0))
         dY = self.deriv(Y, acc)
-        if not np.isfinite(dY).all():
-            raise FloatingPointError(f"non-finite derivative at t = {t:.9g} s")
+        outputs = (acc.constraint_force, acc.multipliers, acc.control_force, acc.unmodeled_force)
+        if not (
+            np.isfinite(dY).all()
+            and all(np.isfinite(x).all() for x in outputs)
+            and np.isfinite(acc.residual)
+        ):
+            raise FloatingPointError(
+                f"non-finite derivative or output (accelerations, constraint forces, "
+                f"multipliers or the solve's residual) at t = {t:.9g} s"
+            )
         return dY
 
     def scale(

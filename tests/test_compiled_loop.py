@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numba
@@ -1151,4 +1152,23 @@ def test_the_rows_a_program_counts_at_the_start_are_checked_as_at_every_stage():
         system = gmuk.System([gmuk.RigidBody("a", 1.0, np.eye(3))], [NaNFirst()])
         state = system.state(g={"a": np.eye(4)}, V={"a": np.zeros(6)})
         with pytest.raises(SimulationError, match=r"NaN or inf|not finite"):
+            run(system, state)
+
+
+def test_a_run_whose_outputs_overflow_fails_in_both_loops():
+    """An inequality whose value is 1e300 gives finite derivatives but an infinite solve
+    residual: both loops fail there instead of reporting success with inf in the outputs."""
+
+    class Huge(gmuk.InequalityConstraint):
+        def value(self, q, nu, t):
+            return 1e300
+
+    for run in (
+        lambda s, x: s.simulate(x, (0.0, 1e-3), method="RK4", step=2.5e-4),
+        lambda s, x: reference_simulate(s, x, (0.0, 1e-3), method="RK4", step=2.5e-4),
+    ):
+        system = gmuk.System([gmuk.PointMass("a", 2.0)], [Huge(["a"], lower=-10.0)])
+        state = system.state(r={"a": [1.0, 0.0, 0.0]}, v={"a": [0.0, 1.0, 0.5]})
+        with warnings.catch_warnings(), pytest.raises(SimulationError, match="non-finite"):
+            warnings.simplefilter("ignore", RuntimeWarning)  # numpy's overflow, in Python
             run(system, state)

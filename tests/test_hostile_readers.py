@@ -506,7 +506,7 @@ def test_gmuk_view_of_an_unwritable_output_or_a_hostile_file_exits_2_with_a_mess
     blocker = tmp_path / "file"
     blocker.write_text("")
     assert main(["view", str(saved), "--out", str(blocker / "v.html")]) == 2
-    assert "gmuk view: cannot write" in capsys.readouterr().err
+    assert "cannot write" in capsys.readouterr().err
     npy = tmp_path / "t.npy"
     np.save(npy, np.zeros(3))
     assert main(["view", str(npy)]) == 2

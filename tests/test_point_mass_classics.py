@@ -25,11 +25,11 @@ class RotatingWire(gmuk.HolonomicConstraint):
 
     def __init__(self, body, rate):
         super().__init__([body])
-        self.rate = rate
+        self.spin = rate
 
     def residual(self, q, t):
         (r,) = q
-        c, s = np.cos(self.rate * t), np.sin(self.rate * t)
+        c, s = np.cos(self.spin * t), np.sin(self.spin * t)
         return np.array([-r[0] * s + r[1] * c, r[2]])
 
 

@@ -849,7 +849,10 @@ class _Loop:
             return _loop_failure(f"reached max_steps = {self.run_args.max_steps}")
         if status == _compiled.FIELD:
             return self._field_failure(prog, t_bad, int(ints[_compiled.I_FIELD]))
-        return _loop_failure(f"non-finite derivative at t = {t_bad:.9g} s")
+        return _loop_failure(
+            f"non-finite derivative or output (accelerations, constraint forces, multipliers "
+            f"or the solve's residual) at t = {t_bad:.9g} s"
+        )
 
     def _field_failure(self, prog: _program.Program, t_bad: float, code: int) -> BaseException:
         """A compiled force kernel's failure, described by the model that failed: the

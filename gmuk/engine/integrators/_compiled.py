@@ -78,7 +78,7 @@ class Status(enum.IntEnum):
     DONE = 0  #: reached the end time (rhs: evaluated)
     PAUSE = 1  #: ran its chunk of steps
     FULL = 2  #: the output buffers have no room for the next step's outputs
-    NONFINITE = -1  #: a derivative with NaN or inf
+    NONFINITE = -1  #: a derivative or an output (aux) with NaN or inf
     UNDERFLOW = -2  #: step size underflow
     MAX_STEPS = -3  #: max_steps reached
     FIELD = -4  #: a compiled part's kernel failed (its status in ints[I_FIELD])
@@ -230,6 +230,9 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
         dY[x0 + 2 * ne + i] = z_dot[i]
     for i in range(dY.shape[0]):
         if not math.isfinite(dY[i]):
+            return NONFINITE
+    for i in range(aux.shape[0]):  # the outputs too: forces, multipliers, the residual
+        if not math.isfinite(aux[i]):
             return NONFINITE
     return DONE
 
