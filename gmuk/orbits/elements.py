@@ -248,6 +248,11 @@ def perifocal_state(p: Any, e: Any, nu: Any, mu: Any) -> tuple[FloatArray, Float
     r_P, v_P : ndarray, shape (..., 3)
         m and m/s, in P.
 
+    Raises
+    ------
+    OrbitError
+        When the state overflows float64 (an eccentricity near 1e308, say).
+
     References
     ----------
     McCann (2020), Eq. (69) (``r_{d/P}``, with ``h²/μ = p``); Vallado (2013), Algorithm 10.
@@ -259,13 +264,18 @@ def perifocal_state(p: Any, e: Any, nu: Any, mu: Any) -> tuple[FloatArray, Float
     p, e, nu, mu = np.broadcast_arrays(p, e, nu, mu)
     _check_nu(nu, e)
     c, s = np.cos(nu), np.sin(nu)
-    r = p / (1.0 + e * c)
-    k = np.sqrt(mu / p)
-    zero = np.zeros_like(r)
-    return (
-        np.stack([r * c, r * s, zero], axis=-1),
-        np.stack([-k * s, k * (e + c), zero], axis=-1),
-    )
+    with np.errstate(over="ignore", invalid="ignore"):  # checked below, with a clear error
+        r = p / (1.0 + e * c)
+        k = np.sqrt(mu / p)
+        zero = np.zeros_like(r)
+        r_P = np.stack([r * c, r * s, zero], axis=-1)
+        v_P = np.stack([-k * s, k * (e + c), zero], axis=-1)
+    if not (np.isfinite(r_P).all() and np.isfinite(v_P).all()):
+        raise OrbitError(
+            "the perifocal state is not finite in float64 (p, e, ν, μ too large or too "
+            "small for one another)"
+        )
+    return r_P, v_P
 
 
 def elements_to_state(

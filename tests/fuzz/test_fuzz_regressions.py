@@ -3,6 +3,8 @@ does (one test per behaviour)."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -267,3 +269,13 @@ def test_campaign_parameter_values_beyond_float64_are_refused_as_not_finite(name
     }
     with pytest.raises(DefinitionError, match="must be finite"):
         Campaign.from_function(campaign_metrics, params, runs=2, fixed={name: value})
+
+
+def test_a_perifocal_state_that_overflows_float64_is_an_orbit_error():
+    from gmuk.errors import OrbitError
+    from gmuk.orbits import elements_to_state
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no RuntimeWarning on the way
+        with pytest.raises(OrbitError, match="not finite"):
+            elements_to_state(None, 1.7976931348623157e308, 1e-36, 0, 0, 0, 3.986e14, p=1000.0)
