@@ -387,14 +387,25 @@ class RowsScript(Script):
         if isinstance(b, (np.ndarray, np.generic, float, int)) and np.ndim(b) == 0:
             b = np.reshape(b, (1,))
         # any number of rows s ≥ 1, the same for A and b (a run that changes it is refused)
-        s = np.shape(A)[0] if np.ndim(A) == 2 else 1
+        try:
+            s = np.shape(A)[0] if np.ndim(A) == 2 else 1
+        except ValueError:  # ragged nested lists: no shape at all
+            return False
         return s >= 1 and check(A, (s, self.dof)) and check(b, (s,))
+
+    def _rows(self) -> set[int]:
+        """The row counts of the values returned (one for a run that keeps its count)."""
+        return {int(np.shape(v[0])[0]) if np.ndim(v[0]) == 2 else 1 for v in self.returned}
 
     def honest(self, shape=None) -> bool:
         # honest and solvable: a zero row with b ≠ 0 may be refused as inconsistent
-        return not self.raised and all(
-            self._ok(v, _honest) and np.abs(np.asarray(v[0], dtype=float)).max() > 1e-3
-            for v in self.returned
+        return (
+            not self.raised
+            and all(
+                self._ok(v, _honest) and np.abs(np.asarray(v[0], dtype=float)).max() > 1e-3
+                for v in self.returned
+            )
+            and len(self._rows()) == 1  # a run keeps its number of rows
         )
 
     def acceptable(self, shape=None) -> bool:
