@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import gmuk
+from gmuk import runs
 from gmuk.lie import se3
 from gmuk.reference import ReferenceState, ReferenceTrajectory
 
@@ -71,3 +72,17 @@ def kkt_solve(M, a, A, b):
     K = np.block([[M, A.T], [A, np.zeros((s, s))]])
     sol = np.linalg.solve(K, np.concatenate([M @ a, b]))
     return sol[:n], sol[n:]
+
+
+class StopAt(gmuk.ForceModel):
+    """No force; asks the enclosing run to stop once t passes ``t_stop``."""
+
+    def __init__(self, t_stop):
+        super().__init__()
+        self.t_stop = t_stop
+
+    def force(self, t, r_N, v_N, body):
+        control = runs.current()
+        if control is not None and t > self.t_stop:
+            control.request_stop()
+        return np.zeros(3)

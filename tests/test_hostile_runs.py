@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import StopAt
 
 import gmuk
 from gmuk import runs
@@ -146,20 +147,6 @@ def test_a_folder_lock_is_refused_to_a_second_holder_and_free_after_release(tmp_
 
 
 # --- checkpoints -------------------------------------------------------------------------------
-
-
-class StopAt(gmuk.ForceModel):
-    """No force; asks the enclosing run to stop once t passes ``t_stop``."""
-
-    def __init__(self, t_stop):
-        super().__init__()
-        self.t_stop = t_stop
-
-    def force(self, t, r_N, v_N, body):
-        control = runs.current()
-        if control is not None and t > self.t_stop:
-            control.request_stop()
-        return np.zeros(3)
 
 
 def _spring(t_stop=1e9):

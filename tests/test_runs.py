@@ -4,24 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import StopAt
 
 import gmuk
 from gmuk import runs
 from gmuk.runs import CheckpointError
-
-
-class StopAt(gmuk.ForceModel):
-    """No force; asks the enclosing run to stop once t passes ``t_stop``."""
-
-    def __init__(self, t_stop):
-        super().__init__()
-        self.t_stop = t_stop
-
-    def force(self, t, r_N, v_N, body):
-        control = runs.current()
-        if control is not None and t > self.t_stop:
-            control.request_stop()
-        return np.zeros(3)
 
 
 def _pendulum(extra=()):
