@@ -298,8 +298,7 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
             modeled[i] += io[lo + i]
             unmodeled[i] += io[lo + ndof + i]
     rank_at = 5 * ndof + s + 1 + nc
-    if s and d.solve == FUSED:
-        # rigid bodies only, every load seen by the solve: the rows, then one compiled call
+    if s:  # the stacked rows, for the fused or the dense solve
         A = np.zeros((s, ndof))
         b = np.empty(s)
         status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
@@ -307,6 +306,8 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
             ints[I_FIELD] = status
             _write_state(t, g, V, Y, d, io)
             return FIELD
+    if s and d.solve == FUSED:
+        # rigid bodies only, every load seen by the solve: one compiled call
         out = np.empty(4 * ndof + s + 3)
         uk_rigid(V, modeled, A, b, parts.uk_params, out)
         if out[4 * ndof + s + 2] != 0.0:  # not certified: the Python solve decides
@@ -338,13 +339,6 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
             aux[i] = 0.0
         aux[rank_at] = d.free_rank
         if s:  # the dense strategy's certified QR solve (DenseSolver.solve_rows)
-            A = np.zeros((s, ndof))
-            b = np.empty(s)
-            status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
-            if status != 0:
-                ints[I_FIELD] = status
-                _write_state(t, g, V, Y, d, io)
-                return FIELD
             ac = aux[2 * ndof : 3 * ndof]
             P = parts.uk_params
             Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
