@@ -3,7 +3,8 @@
     gmuk --version
     gmuk list
     gmuk plugins
-    gmuk run [NAME] [--out DIR] [--no-plots] [--format FMT] [--checkpoint-every S] [options]
+    gmuk run [NAME] [--out DIR] [--no-plots] [--csv] [--format FMT] [--checkpoint-every S]
+             [options]
     gmuk run [NAME] --resume DIR
     gmuk run NAME --help
     gmuk check [--seed S] [--samples N] [--verbose]
@@ -40,7 +41,15 @@ there. The kernel releases the lock when its process ends, however it ends: a ki
 blocks the next one.
 
 ``gmuk view`` writes an interactive 3-D view of a run (:mod:`gmuk.view`): one HTML file that
-opens offline in a browser. ``gmuk run`` writes it as ``DIR/view.html`` unless ``--no-plots``.
+opens offline in a browser. ``gmuk run`` writes it as ``DIR/view.html`` unless ``--no-plots``,
+loading plotly.js from one shared copy in DIR's parent folder (``plotly-<version>.min.js``,
+written once: docs/view.rst); ``gmuk view`` writes a self-contained page.
+
+What a run spends its time on: any phase longer than 2 s (loading or compiling the step loop,
+simulating, the figures, ...) says so on stderr when 2 s have passed and how long it took when
+it ends (on a terminal, the simulation also shows a progress bar); ``summary.json``'s
+``time_s`` gives each phase's wall time (s) and their total, and ``wall_time_s`` is the
+simulation's. ``--csv`` also writes the primary run as ``DIR/trajectory.csv``.
 ``--out`` names the HTML file; given an existing folder, ``gmuk view`` writes ``view.html``
 into it (as ``cp FILE DIR`` does). The trajectory file is checked as
 :func:`gmuk.load_trajectory` checks it; a file it refuses, or an output it cannot write,
@@ -67,7 +76,7 @@ from typing import Any, NoReturn
 
 from gmuk import runs, scenarios
 from gmuk._locks import folder_lock
-from gmuk.engine.integrate import versions
+from gmuk.engine.integrate import compile_loop, versions
 from gmuk.errors import GmukError
 from gmuk.runs import RunControl
 from gmuk.scenarios import OptionError, Scenario
@@ -170,6 +179,12 @@ def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
     )
     common.add_argument("--no-plots", action="store_true", help="write data only")
     common.add_argument(
+        "--csv",
+        action="store_true",
+        help="also write the primary run as DIR/trajectory.csv (gmuk.Trajectory.to_csv: t, "
+        "then each body's position, 3-2-1 Euler angles and body-frame twist, SI units)",
+    )
+    common.add_argument(
         "--checkpoint-every",
         type=scenarios.non_negative_float,
         default=60.0,
@@ -203,6 +218,51 @@ def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
             help=option.help_text.replace("%", "%%"),
         )
     return p
+
+
+#: A phase of ``gmuk run`` that lasts longer than this (s) says on stderr what it is doing.
+ANNOUNCE_AFTER_S = 2.0
+
+
+class _Phases:
+    """The wall time of each phase of one ``gmuk run`` (``times``, s, in the order run), and
+    a line on stderr for any phase that lasts longer than :data:`ANNOUNCE_AFTER_S`: what it is
+    doing when that time has passed, and how long it took when it ends."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.times: dict[str, float] = {}
+
+    @contextmanager
+    def phase(self, key: str, doing: str | None) -> Iterator[None]:
+        """Time the block as phase ``key``; ``doing`` (None: the block announces itself) is
+        what the line on stderr says."""
+        start = time.perf_counter()
+        announced = threading.Event()
+
+        def announce() -> None:
+            announced.set()
+            print(f"gmuk: {self.name}: {doing} ...", file=sys.stderr, flush=True)
+
+        timer = threading.Timer(ANNOUNCE_AFTER_S, announce)
+        timer.daemon = True
+        if doing is not None:
+            timer.start()
+        try:
+            yield
+        finally:
+            timer.cancel()
+            elapsed = time.perf_counter() - start
+            self.times[key] = self.times.get(key, 0.0) + elapsed
+            if announced.is_set():
+                print(f"gmuk: {self.name}: {doing}: {elapsed:.1f} s", file=sys.stderr, flush=True)
+
+    def summary(self) -> dict[str, float]:
+        """``summary.json``'s ``time_s``: each phase's wall time and their total (s)."""
+        return {
+            **{k: round(v, 3) for k, v in self.times.items()},
+            "total": round(sum(self.times.values()), 3),
+        }
 
 
 #: Exit status of a run stopped by a signal: 128 + the signal's number, as shells report it.
@@ -336,16 +396,21 @@ def _run_owned(
         texts = {o.name: o.show(options[o.name]) for o in scenario.options}
         record = {"scenario": scenario.name, "options": texts}
         write_text_atomic(folder / "run.json", json.dumps(record, indent=2) + "\n")
-    t0 = time.perf_counter()
+    shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)
+    phases = _Phases(scenario.name)
+    with phases.phase("loop", None):  # the step loop, loaded from numba's cache or compiled
+        compile_loop()  # (once per machine, announced on stderr by compile_loop itself)
     with runs.run_control(folder, every_s=every, resume=args.resume is not None) as control:
         with _stopping_signals(control) as received:
-            result = scenario.run(**options)
-    elapsed = time.perf_counter() - t0
+            with phases.phase("simulation", f"simulating{f' ({shown})' if shown else ''}"):
+                result = scenario.run(**options)
+    elapsed = phases.times["simulation"]
     primary = result.trajectories[result.primary]
     stopped = [k for k, v in result.trajectories.items() if v.status not in ("success", "drifted")]
     # completed runs whose constraint drifted past simulate's drift_tol
     drifted = [k for k, v in result.trajectories.items() if v.status == "drifted"]
-    path = primary.save(out / "trajectory.npz")
+    with phases.phase("save", "writing trajectory.npz"):
+        path = primary.save(out / "trajectory.npz")
     status = primary.status
     if status == "success":
         status = "partial" if stopped else "drifted" if drifted else "success"
@@ -365,7 +430,8 @@ def _run_owned(
         },
         "options": {k: list(v) if isinstance(v, tuple) else v for k, v in options.items()},
         **({"orbits": options["orbits"]} if "orbits" in options else {}),
-        "wall_time_s": elapsed,
+        "wall_time_s": elapsed,  # the simulation phase, as time_s["simulation"]
+        "time_s": phases.summary(),
         # what computed it: the same inputs give the same bits under the same versions
         "versions": primary.stats.get("versions") or versions(),
         **result.summary,
@@ -382,10 +448,22 @@ def _run_owned(
     if not stopped:
         shutil.rmtree(folder, ignore_errors=True)  # complete: the checkpoints are spent
     with _stopping_signals(control) as received:  # a signal now ends the run after this step
-        extra = scenario.write_data(result, out) if scenario.write_data is not None else []
-        figures = [] if args.no_plots or received else scenario.figures(result, out, formats)
+        extra: list[Path] = []
+        if scenario.write_data is not None:
+            with phases.phase("data", "writing the scenario's data files"):
+                extra = scenario.write_data(result, out)
+        if args.csv and not received:
+            with phases.phase("csv", "writing trajectory.csv"):
+                extra.append(primary.to_csv(out / "trajectory.csv"))
+        figures: list[Path] = []
         if not (args.no_plots or received):
-            figures.append(_write_run_view(primary, out, scenario))
+            with phases.phase("figures", "drawing the figures"):
+                figures = scenario.figures(result, out, formats)
+        if not (args.no_plots or received):
+            with phases.phase("view", "writing the 3-D view"):
+                figures.append(_write_run_view(primary, out, scenario))
+    summary["time_s"] = phases.summary()  # now with the files' phases
+    write_text_atomic(out / "summary.json", json.dumps(summary, indent=2, default=str) + "\n")
     if received:
         print(
             f"{result.name}: stopped by {signal.Signals(received[0]).name} after the run "
@@ -395,10 +473,12 @@ def _run_owned(
             file=sys.stderr,
         )
         return EXIT_STATUS[signal.Signals(received[0])]
-    shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)
-    print(f"{result.name}{f' ({shown})' if shown else ''}: {elapsed:.2f} s, status {status}")
-    for key, value in result.summary.items():
-        print(f"  {key}: {value:.6g}" if isinstance(value, float) else f"  {key}: {value}")
+    spent = ", ".join(f"{k} {v:.2f}" for k, v in phases.times.items() if k != "simulation")
+    print(
+        f"{result.name}{f' ({shown})' if shown else ''}: {elapsed:.2f} s, status {status} "
+        f"(and {spent} s)"
+    )
+    print("\n".join(_summary_lines(result.summary)))
     for key, check in summary["constraint_violation"].items():
         worst = ", ".join(
             f"{level} {check[level]:.3g}"
@@ -414,6 +494,34 @@ def _run_owned(
             print(f"{result.name}: run {k!r}: {result.trajectories[k].message}", file=sys.stderr)
         return EXIT_DRIFTED
     return 0
+
+
+def _cell(value: Any) -> str:
+    """One value of a run's summary as printed: floats to 6 significant digits, a list of
+    records as its length (summary.json has them whole)."""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        return f"[{len(value)} records: summary.json]"
+    return str(value)
+
+
+def _summary_lines(summary: dict[str, Any]) -> list[str]:
+    """The scenario's summary as printed by ``gmuk run``: ``key: value`` lines, then the
+    entries that are themselves mappings (e.g. one per case) as one table, a column each."""
+    lines = [f"  {k}: {_cell(v)}" for k, v in summary.items() if not isinstance(v, dict)]
+    groups = {k: v for k, v in summary.items() if isinstance(v, dict)}
+    if groups:
+        rows = list(dict.fromkeys(key for group in groups.values() for key in group))
+        cells = [[_cell(group.get(row, "")) for group in groups.values()] for row in rows]
+        first = max(len(r) for r in rows)
+        widths = [max(len(str(name)), *(len(c[j]) for c in cells)) for j, name in enumerate(groups)]
+        head = "  ".join(f"{n!s:>{w}}" for n, w in zip(groups, widths, strict=True))
+        lines.append(f"  {'':<{first}}  {head}")
+        for row, values in zip(rows, cells, strict=True):
+            body = "  ".join(f"{c:>{w}}" for c, w in zip(values, widths, strict=True))
+            lines.append(f"  {row:<{first}}  {body}")
+    return lines
 
 
 def _check(args: argparse.Namespace) -> int:
@@ -531,6 +639,7 @@ def _write_run_view(primary: Any, out: Path, scenario: Scenario) -> Path:
         out / "view.html",
         central_radius=scenario.central_radius,
         title=f"gmuk run {scenario.name}",
+        library=out.resolve().parent,  # one plotly.js beside the run folders, shared
     )
 
 

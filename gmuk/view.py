@@ -22,16 +22,20 @@ The page is plotly.js plus the data. The data are decimated so that a long run s
 each path is drawn through at most ``max_path_points`` samples (default 2000) and the
 animation has at most ``max_frames`` frames (default 150), both taken evenly spaced in the
 output index (the outputs of a gmuk run are evenly spaced in time), always keeping the first
-and last outputs. A view of one body is then about 5.1 MB whatever the run's length (a
-one-orbit FCEI run, 721 outputs: 5.06 MB).
+and last outputs. A self-contained view of one body is then about 5.1 MB whatever the run's
+length (a one-orbit FCEI run, 721 outputs: 5.06 MB), of which 4.8 MB is plotly.js; a view
+that loads a shared copy of it (``write_view(..., library=FOLDER)``, as ``gmuk run`` writes
+them) is about 0.3 MB.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 from pathlib import Path
 from typing import Any
+from urllib.parse import quote
 
 import numpy as np
 
@@ -39,7 +43,7 @@ from gmuk._validation import FloatArray, real_number, strict_integer
 from gmuk.errors import DefinitionError
 from gmuk.trajectory import Trajectory, write_text_atomic
 
-__all__ = ["decimate", "view_html", "write_view"]
+__all__ = ["decimate", "plotly_js_name", "view_html", "write_plotly_js", "write_view"]
 
 #: Colours of body axes 1, 2, 3 (red, green, blue, as in most 3-D tools).
 AXIS_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
@@ -111,6 +115,7 @@ def view_html(
     triad_length: float | None = None,
     max_frames: int = 150,
     max_path_points: int = 2000,
+    plotly_src: str | None = None,
 ) -> str:
     """The HTML page of an interactive, offline 3-D view of ``traj``.
 
@@ -131,11 +136,17 @@ def view_html(
         Most animation frames (≥ 2); see the module's notes on decimation.
     max_path_points : int
         Most samples per drawn path (≥ 2).
+    plotly_src : str, optional
+        None (default): plotly.js is embedded, and the page is the whole view. Otherwise the
+        page loads plotly.js from this URL, relative to the page (a file written by
+        :func:`write_plotly_js`); if it is missing there the page says so and how to make a
+        self-contained view.
 
     Returns
     -------
     str
-        A complete HTML document with plotly.js embedded: it makes no network request.
+        A complete HTML document: it makes no network request (with ``plotly_src``, only
+        the file it names).
 
     Raises
     ------
@@ -326,14 +337,56 @@ def view_html(
     html: str = plotly.io.to_html(
         fig,
         validate=False,
-        include_plotlyjs=True,
+        include_plotlyjs=True if plotly_src is None else plotly_src,
         include_mathjax=False,
         full_html=True,
         auto_play=False,  # start at t0; the Play button animates
         default_height="92vh",
         config={"displaylogo": False, "responsive": True},
     )
+    if plotly_src is not None:  # a page without its library says so instead of staying blank
+        html = html.replace("<body>", "<body>" + _missing_library_note(plotly_src), 1)
     return html
+
+
+def _missing_library_note(src: str) -> str:
+    """A script that, when the page has loaded without plotly.js, replaces it by a note."""
+    note = (
+        f"This view loads its plotting library from {src!r} beside its folder, which is "
+        "missing. Make a self-contained view (one file, no library beside it) with: "
+        "gmuk view RUN_DIR --out view.html"
+    )
+    return (
+        "<script>window.addEventListener('load', function () {"
+        "if (typeof Plotly === 'undefined') {"
+        f"document.body.textContent = {json.dumps(note)};"
+        "}});</script>"
+    )
+
+
+def plotly_js_name() -> str:
+    """The file name of the shared plotly.js library, with its version:
+    ``plotly-<version>.min.js``."""
+    from plotly.offline import get_plotlyjs_version
+
+    return f"plotly-{get_plotlyjs_version()}.min.js"
+
+
+def write_plotly_js(folder: str | Path) -> Path:
+    """Write plotly.js (4.8 MB) into ``folder`` as :func:`plotly_js_name`, once: a file
+    already there with the same content is kept. Views written with ``plotly_src``
+    pointing at it share it (``gmuk run`` does, one copy per output root)."""
+    from plotly.offline import get_plotlyjs
+
+    path = Path(folder) / plotly_js_name()
+    text = get_plotlyjs()
+    try:
+        if path.read_text(encoding="utf-8") == text:
+            return path
+    except (OSError, UnicodeDecodeError):
+        pass  # not there yet, or not this library: write it
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return write_text_atomic(path, text)
 
 
 def write_view(
@@ -342,6 +395,7 @@ def write_view(
     *,
     central_radius: float | None = None,
     title: str = "",
+    library: str | Path | None = None,
     **options: Any,
 ) -> Path:
     """Write :func:`view_html` of ``traj`` to ``path`` (atomically); returns the path.
@@ -354,6 +408,11 @@ def write_view(
     central_radius : float, optional
         Radius (m) of the central body sphere.
     title : str
+    library : str or Path, optional
+        None (default): the page embeds plotly.js (4.8 MB) and is the whole view. A folder:
+        plotly.js is written there once (:func:`write_plotly_js`) and the page loads it by
+        its path relative to the page (about 0.3 MB a page): views of many runs share one
+        copy, and a page moved away from it says so when opened.
     **options
         ``triad_length`` (m), ``max_frames``, ``max_path_points``, as :func:`view_html`.
 
@@ -381,6 +440,11 @@ def write_view(
             f"write_view: cannot write {str(path)!r}: {str(blocking)!r} is a file, not a folder"
         )
     path.parent.mkdir(parents=True, exist_ok=True)
+    src = None
+    if library is not None:
+        shared = write_plotly_js(library).resolve()
+        src = quote(Path(os.path.relpath(shared, path.parent.resolve())).as_posix())
     return write_text_atomic(
-        path, view_html(traj, central_radius=central_radius, title=title, **options)
+        path,
+        view_html(traj, central_radius=central_radius, title=title, plotly_src=src, **options),
     )

@@ -19,6 +19,7 @@ import gmuk
 from gmuk import _plugins, cli, plotting, scenarios
 from gmuk.errors import DefinitionError, GmukError, PluginWarning
 from gmuk.scenarios import Option, OptionError, Scenario, ScenarioResult
+from gmuk.view import plotly_js_name
 
 # --- a scenario that is not part of gmuk --------------------------------------------------------
 
@@ -223,6 +224,33 @@ def test_gmuk_run_alone_runs_fcei_with_its_defaults(tmp_path, monkeypatch, capsy
     assert "fcei (orbits=1.0)" in capsys.readouterr().out
 
 
+def test_a_run_says_what_it_is_doing_and_what_its_time_went_to(
+    plugins, tmp_path, monkeypatch, capsys
+):
+    """Every phase longer than ANNOUNCE_AFTER_S is announced on stderr with its time; the
+    summary's time_s has every phase and their total; --csv writes the primary run."""
+    plugins(_EntryPoint("tumble", lambda: TUMBLE))
+    monkeypatch.setattr(cli, "ANNOUNCE_AFTER_S", 0.0)  # every phase counts as long
+    out = tmp_path / "runs" / "t"
+    assert cli.main(["run", "tumble", "--duration", "1", "--csv", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    for doing in ("simulating (spin=1", "writing trajectory.npz", "writing trajectory.csv"):
+        assert f"gmuk: tumble: {doing}" in err, err
+    assert "gmuk: tumble: drawing the figures: " in err and "3-D view" in err
+    times = json.loads((out / "summary.json").read_text())["time_s"]
+    phases = ["loop", "simulation", "save", "csv", "figures", "view"]
+    assert list(times) == [*phases, "total"]
+    assert times["total"] == pytest.approx(sum(times[k] for k in phases), abs=1e-2)
+    header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
+    table = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
+    traj = gmuk.load_trajectory(out / "trajectory.npz")
+    assert header[:2] == ["t_s", "box.x_m"] and table.shape == (len(traj), len(header))
+    np.testing.assert_array_equal(table[:, 0], traj.t)
+    # the view loads the one plotly.js written beside the run folders
+    assert (tmp_path / "runs" / plotly_js_name()).is_file()
+    assert f'src="../{plotly_js_name()}"' in (out / "view.html").read_text()
+
+
 def test_declared_defaults_are_the_run_functions_defaults():
     for scenario, _ in scenarios.available():
         params = inspect.signature(scenario.run).parameters
@@ -315,3 +343,23 @@ def test_an_impossible_span_or_output_folder_is_a_clear_error(tmp_path, capsys):
     blocker.write_text("not a folder")
     assert cli.main(["run", "fcei", "--orbits", "0.01", "--out", str(blocker / "sub")]) == 2
     assert "cannot make the output folder" in capsys.readouterr().err
+
+
+def test_a_summary_of_cases_prints_as_one_table():
+    """smd-compare's summary is one mapping per case: printed as a column per case, rows
+    aligned, a list of records as its length, a key missing from a case left blank."""
+    lines = cli._summary_lines(
+        {
+            "steps": 12,
+            "gt": {"objective": 37393.6123, "status": "ok", "refinement": [{"n": 1}, {"n": 2}]},
+            "bi": {"objective": 1580.47, "status": "ok", "only_here": 1e-9},
+        }
+    )
+    assert lines[0] == "  steps: 12"
+    head, *rows = lines[1:]
+    assert head.split() == ["gt", "bi"]
+    table = {r.split()[0]: r for r in rows}
+    assert table["objective"].split() == ["objective", "37393.6", "1580.47"]
+    assert table["refinement"].split()[1:] == ["[2", "records:", "summary.json]"]
+    assert table["only_here"].split() == ["only_here", "1e-09"]
+    assert len({len(r) for r in lines[1:]}) == 1  # every row as wide as the head: aligned

@@ -20,7 +20,7 @@ from gmuk.celestial import MOON_RADIUS
 from gmuk.cli import main
 from gmuk.errors import DefinitionError
 from gmuk.orbits import fcei_orbit
-from gmuk.view import decimate, view_html, write_view
+from gmuk.view import decimate, plotly_js_name, view_html, write_plotly_js, write_view
 
 
 def orbit_trajectory(n: int = 400, orbits: float = 1.0) -> gmuk.Trajectory:
@@ -276,3 +276,41 @@ def test_orbit_scenarios_declare_the_moon_and_a_bad_radius_is_refused():
     assert radii["smd-gt"] is None
     with pytest.raises(DefinitionError, match="central_radius must be a finite number > 0"):
         Scenario("x", "x", lambda: None, lambda r, o, f: [], central_radius=-1.0)
+
+
+def test_views_sharing_one_plotly_library_render_offline_and_say_when_it_is_gone(
+    chromium, tmp_path
+):
+    """``gmuk run``'s views load one plotly.js beside the run folders (``library=``): each
+    page is small, renders as the self-contained one does, and a page moved away from the
+    library says how to make a self-contained view instead of staying blank."""
+    traj = orbit_trajectory(n=300)
+    pages = [
+        write_view(traj, tmp_path / run / "view.html", central_radius=MOON_RADIUS, library=tmp_path)
+        for run in ("run a", "run b")  # a space in the folder: the page quotes the URL
+    ]
+    assert [p.name for p in tmp_path.glob("plotly-*.min.js")] == [plotly_js_name()]
+    embedded = view_html(traj, central_radius=MOON_RADIUS)
+    assert all(p.stat().st_size < 0.1 * len(embedded) for p in pages)
+    image, requests = render(chromium, pages[0], tmp_path / "shared.png")
+    assert [u for u in requests if not u.startswith("file:")] == []
+    assert sphere_pixels(image) > 15_000
+    (tmp_path / plotly_js_name()).unlink()
+    dom = subprocess.run(
+        [chromium, *FLAGS, f"--user-data-dir={tmp_path}/p", "--dump-dom", pages[1].as_uri()],
+        check=True,
+        capture_output=True,
+        text=True,
+        timeout=180,
+    ).stdout
+    assert "plotting library" in dom and "gmuk view RUN_DIR --out view.html" in dom
+
+
+def test_write_plotly_js_keeps_a_good_copy_and_replaces_a_damaged_one(tmp_path):
+    first = write_plotly_js(tmp_path)
+    stamp = first.stat().st_mtime_ns
+    assert write_plotly_js(tmp_path).stat().st_mtime_ns == stamp  # the same: not rewritten
+    first.write_text("truncated")
+    from plotly.offline import get_plotlyjs
+
+    assert write_plotly_js(tmp_path).read_text() == get_plotlyjs()
