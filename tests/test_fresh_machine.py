@@ -124,6 +124,9 @@ def test_the_readme_set_up_installs_the_plugins_the_tests_use_and_ci_runs_it():
     assert "/^## Set up/" in ci and "README.md" in ci
     assert '-c "${SETUP[0]}"' in ci and '-c "${SETUP[1]}"' in ci
     assert "export GMUK_REQUIRE_CHROMIUM=1" in ci and "apt-get install" in ci
+    # the docs' front page gives the same two commands
+    index = (ROOT / "docs" / "index.rst").read_text()
+    assert f"   {first.strip()}\n   {second.strip()}\n" in index
 
 
 # --- failures name public errors -----------------------------------------------------------------
