@@ -9,7 +9,9 @@ coordinate). The System places the columns into the global A.
 from __future__ import annotations
 
 import abc
-from collections.abc import Sequence
+import functools
+import inspect
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -28,13 +30,20 @@ if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
 
-__all__ = ["ROWS_KERNEL", "Baumgarte", "Constraint"]
+__all__ = ["BASE_KEYWORDS", "ROWS_KERNEL", "Baumgarte", "Constraint"]
 
 #: The signature of a constraint's rows kernel, as the compiled loop calls it:
 #: ``(t, g_1 (4, 4), V_1 (6,), g_2, V_2, p, A (s, 12), b (s,)) -> status``, writing the rows
 #: of the constraint on its first body (columns 0–5) and its second one (columns 6–11; zero,
 #: and ``g_2, V_2`` ignored, for a one-body constraint); status 0 or a failure code.
 ROWS_KERNEL = numba_types.int64(numba_types.float64, C2, C1, C2, C1, C1, C2, C1)
+
+#: The keywords of gmuk's constraint kinds that a subclass takes whether or not its own
+#: ``__init__`` names them (:meth:`Constraint.__init_subclass__`), with the default of every
+#: kind that takes them: ``name`` (every kind); ``baumgarte`` (the residual kinds — holonomic,
+#: nonholonomic, inequality — and the tracking and relative constraints); ``fd_length`` and
+#: ``fd_time`` (the residual kinds).
+BASE_KEYWORDS: dict[str, Any] = {"name": None, "baumgarte": None, "fd_length": 1.0, "fd_time": 1.0}
 
 
 @dataclass(frozen=True)
@@ -85,6 +94,18 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
     :class:`gmuk.Body` objects or names; the System checks that they exist. A constraint is
     frozen once it is handed to a System (its attributes can no longer be set).
 
+    **Keywords of the base class.** A subclass takes the keywords of the gmuk kind it builds
+    on (:data:`BASE_KEYWORDS`: ``name`` for every kind; ``baumgarte`` where the kind applies
+    Baumgarte gains; ``fd_length``, ``fd_time`` for the residual kinds) even when its own
+    ``__init__`` does not name them: the class holds them back from that ``__init__`` and hands
+    them to the kind's ``__init__`` when ``super().__init__(...)`` reaches it, so the instance
+    has them from then on, exactly as if they had been forwarded. A keyword that the
+    subclass's ``__init__`` names is its own and passes through untouched (it is never applied
+    twice). A keyword the kind does not take (``baumgarte`` on a kind that gives its rows
+    directly) is a :class:`~gmuk.errors.DefinitionError` naming the kinds that take it, as is
+    one that the subclass also sets itself in its ``super().__init__`` call to another value.
+    ``inspect.signature`` (``help``, IDEs) lists them after the subclass's own parameters.
+
     Parameters
     ----------
     bodies : sequence of Body or str
@@ -106,6 +127,8 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
     ...         self.A, self.b = A, b
     ...     def rows(self, state):
     ...         return self.A, self.b
+    >>> Rows(["a"], np.eye(6)[:3], np.zeros(3), name="lock").name
+    'lock'
     """
 
     #: The kinds of body this constraint can act on (default: every kind).
@@ -116,6 +139,7 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
     _cached_indices: tuple[object, tuple[int, ...]] | None = None
 
     def __init__(self, bodies: Sequence[Body | str], *, name: str | None = None) -> None:
+        (name,) = self._keywords(name=name)
         if isinstance(bodies, str) or not isinstance(bodies, Sequence):
             bodies = [bodies]
         if len(bodies) == 0:
@@ -124,6 +148,45 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
         bodies = distinct_bodies(bodies, who)
         object.__setattr__(self, "_bodies", bodies)
         object.__setattr__(self, "_name", name or type(self).__name__)
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Let a subclass outside gmuk take the keywords of its kind (:data:`BASE_KEYWORDS`)
+        that its own ``__init__`` does not name (see the class docstring)."""
+        super().__init_subclass__(**kwargs)
+        init = cls.__dict__.get("__init__")
+        if init is not None and not _in_gmuk(cls):
+            cls.__init__ = _taking_base_keywords(cls, init)  # type: ignore[method-assign]
+
+    def _keywords(self, **values: Any) -> tuple[Any, ...]:
+        """The values of keywords of :data:`BASE_KEYWORDS`, in the order given, as a kind's
+        ``__init__`` is to use them: each as it came in, or the one the caller gave a subclass
+        whose ``__init__`` does not name it (held back by :meth:`__init_subclass__`). A
+        ``baumgarte`` is checked to be a :class:`Baumgarte` or None.
+
+        Raises
+        ------
+        DefinitionError
+            When the subclass sets a keyword itself that its caller gave too, to another
+            value; for a ``baumgarte`` that is not a Baumgarte.
+        """
+        held = self.__dict__.get("_held_keywords")
+        out: list[Any] = []
+        for key, value in values.items():
+            if held and key in held:
+                given = held.pop(key)
+                if not _is_default(value, BASE_KEYWORDS[key]) and value is not given:
+                    raise DefinitionError(
+                        f"{type(self).__name__} sets {key}={value!r} itself and was given "
+                        f"{key}={given!r} too: give it in one place"
+                    )
+                value = given
+            if key == "baumgarte" and value is not None and not isinstance(value, Baumgarte):
+                raise DefinitionError(
+                    f"baumgarte of {type(self).__name__} must be a gmuk.Baumgarte or None; "
+                    f"got {type(value).__name__}"
+                )
+            out.append(value)
+        return tuple(out)
 
     def _compiled_term(self) -> tuple[Any, tuple[float, ...], int] | None:
         """How the compiled step loop computes this constraint's rows: (its kernel, with the
@@ -221,6 +284,107 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(bodies={list(self.body_names)}, name={self.name!r})"
+
+
+def _in_gmuk(cls: type) -> bool:
+    """Whether ``cls`` is one of gmuk's own classes (which name their keywords)."""
+    return cls.__module__ == "gmuk" or cls.__module__.startswith("gmuk.")
+
+
+def _is_default(value: Any, default: Any) -> bool:
+    """Whether a kind's ``__init__`` got ``value`` as the default ``default`` of its keyword."""
+    if value is default:
+        return True
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    return number and isinstance(default, float) and value == default
+
+
+def _taking_base_keywords(cls: type[Constraint], init: Callable[..., None]) -> Callable[..., None]:
+    """``cls``'s own ``init``, taking the keywords of :data:`BASE_KEYWORDS` it does not name.
+
+    The returned ``__init__`` holds such keywords back from ``init``, in the instance's
+    ``_held_keywords`` for the time of the call; the kind's ``__init__`` takes them from there
+    (:meth:`Constraint._keywords`). It refuses a keyword the kind does not take, and one that
+    no gmuk ``__init__`` took by the end of the call (``init`` did not call
+    ``super().__init__``). Its signature lists the keywords the kind takes after ``init``'s
+    own parameters.
+    """
+    own = inspect.signature(init)
+    named = {
+        k
+        for k, p in own.parameters.items()
+        if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    }
+    caught = tuple(k for k in BASE_KEYWORDS if k not in named)
+    if not caught:
+        return init
+    kind = next(c for c in cls.__mro__ if _in_gmuk(c) and "__init__" in c.__dict__)
+    offered = inspect.signature(kind.__init__).parameters  # type: ignore[misc]
+    taken = [k for k in caught if k in offered]
+
+    @functools.wraps(init)
+    def __init__(self: Constraint, *args: Any, **kwargs: Any) -> None:
+        given = {k: kwargs.pop(k) for k in caught if k in kwargs}
+        if not given:
+            init(self, *args, **kwargs)
+            return
+        refused = [k for k in given if k not in offered]
+        if refused:
+            raise DefinitionError(_refusal(type(self), kind, refused[0], list(offered)))
+        held: dict[str, Any] | None = self.__dict__.get("_held_keywords")
+        outermost = held is None
+        if held is None:
+            held = {}
+            object.__setattr__(self, "_held_keywords", held)
+        for key, value in given.items():
+            if key in held:
+                raise DefinitionError(
+                    f"{type(self).__name__} was given {key} twice ({held[key]!r} and {value!r})"
+                )
+            held[key] = value
+        try:
+            init(self, *args, **kwargs)
+            if outermost and held:
+                raise DefinitionError(
+                    f"{type(self).__name__} was given {', '.join(held)}, but its __init__ did "
+                    f"not call super().__init__(...), whose {kind.__name__} takes them"
+                )
+        finally:
+            if outermost:
+                self.__dict__.pop("_held_keywords", None)
+
+    params = list(own.parameters.values())
+    at = len(params) - (params[-1].kind is inspect.Parameter.VAR_KEYWORD if params else 0)
+    extra = [
+        inspect.Parameter(
+            k,
+            inspect.Parameter.KEYWORD_ONLY,
+            default=offered[k].default,
+            annotation=offered[k].annotation,
+        )
+        for k in taken
+    ]
+    __init__.__signature__ = own.replace(  # type: ignore[attr-defined]
+        parameters=[*params[:at], *extra, *params[at:]]
+    )
+    return __init__
+
+
+def _refusal(cls: type, kind: type, key: str, offered: list[str]) -> str:
+    """Why ``cls`` (built on the gmuk class ``kind``) cannot take the keyword ``key``."""
+    takes = ", ".join(f"{k}=" for k in BASE_KEYWORDS if k in offered)
+    base = next(c for c in cls.__mro__ if _in_gmuk(c)).__name__
+    if key == "baumgarte":
+        why = (
+            f"a {base} gives its rows itself and gmuk knows no residual of it to stabilise; "
+            "add the terms −α Φ̇ − β Φ to its b yourself (McCann 2020, Eq. 4), with gains "
+            "your __init__ takes, or build on a kind that applies baumgarte=: "
+            "gmuk.HolonomicConstraint, gmuk.NonholonomicConstraint, gmuk.InequalityConstraint, "
+            "gmuk.ConfigurationTracking(T2), gmuk.VirtualPairT2 or gmuk.RelativeConstraint"
+        )
+    else:
+        why = f"a {base} has no such option"
+    return f"{cls.__name__} takes no {key}=: {why} (from {base} it takes {takes})"
 
 
 def as_rows(A: Any, b: Any, n_cols: int, who: str) -> tuple[Any, FloatArray]:

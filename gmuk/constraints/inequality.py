@@ -180,6 +180,7 @@ class InequalityConstraint(_Differentiable):
         unit: str = "",
         name: str | None = None,
     ) -> None:
+        (name,) = self._keywords(name=name)  # names the slack coordinates before super()
         if isinstance(bodies, str) or not isinstance(bodies, Sequence):
             bodies = [bodies]
         label = name or type(self).__name__

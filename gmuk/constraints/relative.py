@@ -208,6 +208,7 @@ class RelativeConstraint(Constraint):
         name: str | None = None,
     ) -> None:
         super().__init__([relative_to, body], name=name)
+        (baumgarte,) = self._keywords(baumgarte=baumgarte)
         if (free_axes is None) == (S is None):
             raise ConstraintError("give exactly one of free_axes and S")
         if S is None:

@@ -152,6 +152,7 @@ class ConfigurationTrackingT2(TangentBundleConstraint):
         name: str | None = None,
     ) -> None:
         super().__init__([body], name=name)
+        (baumgarte,) = self._keywords(baumgarte=baumgarte)
         if not isinstance(reference, ReferenceTrajectory):
             raise DefinitionError(
                 f"reference must be a gmuk.ReferenceTrajectory; got {type(reference).__name__}"
@@ -238,6 +239,7 @@ class VirtualPairT2(TangentBundleConstraint):
         name: str | None = None,
     ) -> None:
         super().__init__([relative_to, body], name=name)
+        (baumgarte,) = self._keywords(baumgarte=baumgarte)
         if not isinstance(reference, ReferenceTrajectory):
             raise DefinitionError(
                 f"reference must be a gmuk.ReferenceTrajectory; got {type(reference).__name__}"

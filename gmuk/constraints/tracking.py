@@ -268,6 +268,7 @@ class ConfigurationTracking(Constraint):
         name: str | None = None,
     ) -> None:
         super().__init__([body], name=name)
+        (baumgarte,) = self._keywords(baumgarte=baumgarte)
         if not isinstance(reference, ReferenceTrajectory):
             raise DefinitionError(
                 f"reference must be a gmuk.ReferenceTrajectory; got {type(reference).__name__}"
