@@ -13,10 +13,13 @@ McCann (2020), Eqs. (2)–(3) (point masses), (63)–(64) (rigid bodies on R⁶)
 
 from __future__ import annotations
 
+import difflib
+import functools
+import inspect
 import itertools
 import math
-from collections.abc import Iterable, Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Literal, ParamSpec, TypeVar
 
 import numpy as np
 import scipy.linalg
@@ -42,11 +45,40 @@ from gmuk.forces.base import ForceModel
 from gmuk.state import Layout, State
 
 if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
     from gmuk.engine.integrators import RungeKuttaMethod
     from gmuk.engine.integrators._program import Program
     from gmuk.trajectory import Trajectory
 
 __all__ = ["QR_COND_LIMIT", "QR_MAX_ROWS", "SPARSE_THRESHOLD", "Accelerations", "System"]
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def _names_its_options(func: Callable[_P, _R]) -> Callable[_P, _R]:
+    """``func``, whose keyword-only parameters are its options, refusing an unknown keyword
+    with a TypeError that lists them (and suggests the closest) instead of Python's bare
+    "unexpected keyword argument". ``inspect.signature`` still shows ``func``'s own."""
+    params = inspect.signature(func).parameters
+    options = [k for k, p in params.items() if p.kind is inspect.Parameter.KEYWORD_ONLY]
+    owner = func.__qualname__
+
+    @functools.wraps(func)
+    def checked(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        for key in kwargs:
+            if key not in params:
+                close = difflib.get_close_matches(key, options, n=1)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                raise TypeError(
+                    f"{owner}() got an unexpected keyword argument {key!r}{hint}; its options "
+                    f"are {', '.join(options)}"
+                )
+        return func(*args, **kwargs)
+
+    return checked
+
 
 #: Above this many degrees of freedom, ``sparse="auto"`` selects the sparse solve.
 SPARSE_THRESHOLD = 300
@@ -850,9 +882,91 @@ class System:
         return _program.PYTHON_SOLVE, f"the constraints are solved by {type(self.solver).__name__}"
 
     # ------------------------------------------------------------------ simulation
-    def simulate(self, state0: State, t_span: tuple[float, float], **options: Any) -> Trajectory:
-        """Integrate from ``state0`` over ``t_span``; see :func:`gmuk.engine.integrate.simulate`."""
-        return _simulate(self, state0, t_span, **options)
+    @_names_its_options
+    def simulate(
+        self,
+        state0: State,
+        t_span: tuple[float, float],
+        *,
+        t_eval: ArrayLike | None = None,
+        method: str | type[RungeKuttaMethod] | RungeKuttaMethod = "DOP853",
+        rtol: float = 1e-10,
+        atol: float = 1e-10,
+        step: float | None = None,
+        first_step: float | None = None,
+        max_step: float = np.inf,
+        max_steps: int = 1_000_000,
+        progress: bool | None = None,
+        on_failure: Literal["raise", "return"] = "raise",
+        compiled: bool | None = None,
+        drift_tol: float | None = 1e-6,
+    ) -> Trajectory:
+        """Integrate from ``state0`` over ``t_span`` on SE(3)ⁿ × Rᵏ.
+
+        The options are those of :func:`gmuk.engine.integrate.simulate`, which this calls
+        and whose docstring gives the details (error weights, the drift check, checkpoints).
+        An unknown keyword is a TypeError that lists them.
+
+        Parameters
+        ----------
+        state0 : State
+            Initial state (from :meth:`state`); its ``t`` is replaced by ``t_span[0]``.
+        t_span : (float, float)
+            Start and end times (s), end > start.
+        t_eval : array_like, shape (k,), optional
+            Output times (s), increasing, within ``t_span``. Default: every accepted step.
+        method : str, RungeKuttaMethod subclass or instance
+            The Runge–Kutta method: a registered name, case-insensitive — ``"DOP853"``
+            (default, adaptive, 8th order), ``"DOPRI5"``, ``"RK4"`` (fixed step) or a name a
+            user subclass registered (:data:`gmuk.engine.integrate.METHODS`) — or a class or
+            an instance.
+        rtol, atol : float
+            Relative and absolute tolerances of the adaptive methods (default 1e-10 each);
+            each 3-vector of the state (ω in rad/s, v in m/s, positions in m, the step's
+            rotation in rad) is weighed by its norm: ``w = atol + rtol · ‖u‖``.
+        step : float, optional
+            Step size (s) of a fixed-step method such as RK4 (required there); ignored by the
+            adaptive ones.
+        first_step : float, optional
+            First step (s) of an adaptive method; chosen automatically by default.
+        max_step : float
+            Largest step (s) of an adaptive method (default: no limit).
+        max_steps : int
+            Give up (status "failed") after this many steps (default 1 000 000).
+        progress : bool, optional
+            Progress bar: True always, False never, None (default) only on a terminal once
+            the run has taken more than 2 s.
+        on_failure : {"raise", "return"}
+            On a failure (step-size underflow, NaN, too many steps, an inconsistent solve in
+            strict mode): raise :class:`gmuk.errors.SimulationError` carrying the trajectory
+            so far (default), or return that trajectory with ``status="failed"``.
+        compiled : bool, optional
+            Deprecated and ignored (every run takes the compiled loop); False is an error.
+        drift_tol : float or None
+            How far (in each residual's units; default 1e-6) a constraint may drift from where
+            it started before the run ends with ``status="drifted"``; None records the
+            violations without judging them.
+
+        Returns
+        -------
+        Trajectory
+            Time-major record of the run; ``print(traj)`` summarises it.
+
+        Raises
+        ------
+        DefinitionError
+            For an unknown method name or a bad option value (as
+            :func:`gmuk.engine.integrate.simulate`).
+        SimulationError
+            When the run fails and ``on_failure="raise"``.
+        TypeError
+            For a keyword that is not an option (the message lists the options).
+        """
+        return _simulate(
+            self, state0, t_span, t_eval=t_eval, method=method, rtol=rtol, atol=atol,
+            step=step, first_step=first_step, max_step=max_step, max_steps=max_steps,
+            progress=progress, on_failure=on_failure, compiled=compiled, drift_tol=drift_tol,
+        )  # fmt: skip
 
     def __repr__(self) -> str:
         return (
