@@ -54,9 +54,13 @@ _ARRAYS = (
 )
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class Trajectory:
     """The result of :meth:`gmuk.System.simulate`.
+
+    ``print(traj)`` (and its ``repr``) is a summary of one screen: status, samples and time
+    span, bodies, constraint rows, the largest residual, the drift check, how it was
+    integrated, and the size of its arrays (see :meth:`summary`).
 
     Attributes
     ----------
@@ -127,6 +131,80 @@ class Trajectory:
 
     def __len__(self) -> int:
         return int(self.t.shape[0])
+
+    def summary(self, max_bodies: int = 8) -> str:
+        """A summary of the run in at most 10 lines of at most ~100 characters.
+
+        Parameters
+        ----------
+        max_bodies : int
+            Bodies listed by name (the others are counted).
+
+        Returns
+        -------
+        str
+            Status, number of samples and time span (s); bodies with their kinds; constraint
+            rows (columns of ``multipliers``) and the largest ``residual`` ‖A ν̇ − b‖; the
+            drift check (largest position and velocity residuals, in each constraint's units,
+            against ``drift_tol``) when recorded; method, tolerances, steps and loop when
+            recorded; controller states; the size of the arrays; the message, if any.
+        """
+        n = len(self)
+        span = f"t = {self.t[0]:.6g} … {self.t[-1]:.6g} s" if n else "no samples"
+        lines = [f"<gmuk.Trajectory: {self.status}, {n} sample{'s' * (n != 1)}, {span}>"]
+
+        def row(label: str, text: str) -> None:
+            lines.append(f"{label + ':':<14}{text}")
+
+        groups: dict[str, list[str]] = {}
+        for i, (name, kind) in enumerate(zip(self.body_names, self.body_kinds, strict=True)):
+            if i < max_bodies:
+                groups.setdefault(kind, []).append(name)
+        shown = "; ".join(f"{', '.join(names)} ({kind})" for kind, names in groups.items())
+        more = len(self.body_names) - max_bodies
+        row(f"Bodies ({len(self.body_names)})", shown + (f"; … +{more} more" if more > 0 else ""))
+        finite = self.residual[np.isfinite(self.residual)]
+        largest = f"{finite.max():.2e}" if finite.size else "n/a"
+        s_rows = self.multipliers.shape[1]
+        rows = f"{s_rows} row{'s' * (s_rows != 1)}, largest residual ‖A ν̇ − b‖ {largest}"
+        row("Constraints", rows if s_rows else "none")
+        check = self.stats.get("constraint_violation")
+        if isinstance(check, dict) and check.get("constraints"):
+            tol = check.get("tolerance")
+            verdict = "drifted" if check.get("drifted") else "held"
+            against = "not judged" if tol is None else f"drift_tol {tol:g}: {verdict}"
+            row(
+                "Drift check",
+                f"position ≤ {_brief(check.get('position'))}, velocity ≤ "
+                f"{_brief(check.get('velocity'))} ({len(check['constraints'])} checked; {against})",
+            )
+        how = []
+        if "method" in self.stats:
+            how.append(str(self.stats["method"]))
+        if "rtol" in self.stats and "atol" in self.stats:
+            how.append(f"rtol {self.stats['rtol']:g}, atol {self.stats['atol']:g}")
+        if "compiled" in self.stats:
+            how.append("compiled loop" if self.stats["compiled"] else "Python loop")
+        if how:
+            row("Integration", ", ".join(how))
+        if "n_steps" in self.stats:
+            steps = f"{self.stats['n_steps']} ({self.stats.get('n_rejected', 0)} rejected)"
+            if "n_rhs" in self.stats:
+                steps += f", {self.stats['n_rhs']} evaluations of the dynamics"
+            row("Steps", steps)
+        if self.z.shape[1]:
+            row("Controllers", f"{self.z.shape[1]} internal states (z)")
+        nbytes = sum(getattr(self, k).nbytes for k in _ARRAYS)
+        row("Size", f"{_size(nbytes)} in {len(_ARRAYS)} arrays")
+        if self.message:
+            text = " ".join(self.message.split())
+            row("Message", text if len(text) <= 160 else text[:159] + "…")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return self.summary()
+
+    __str__ = __repr__
 
     def _point_columns(self) -> np.ndarray:
         lay = self.layout
@@ -244,12 +322,29 @@ class Trajectory:
         return path
 
 
+def _brief(value: Any) -> str:
+    """A residual of the drift check: 3 significant digits, or "n/a" for None."""
+    return "n/a" if value is None else f"{value:.2e}"
+
+
+def _size(nbytes: int) -> str:
+    """A number of bytes in B, kB, MB or GB (powers of 1000)."""
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if nbytes >= scale:
+            return f"{nbytes / scale:.1f} {unit}"
+    return f"{nbytes} B"
+
+
 @dataclass(frozen=True, eq=False)
 class BodyTrajectory:
     """Time histories of one body of a :class:`Trajectory`."""
 
     traj: Trajectory
     name: str
+
+    def __repr__(self) -> str:
+        kind = self.traj.body_kinds[self.traj.body_names.index(self.name)]
+        return f"<gmuk.BodyTrajectory {self.name!r} ({kind}), {len(self.traj)} samples>"
 
     def _slot(self) -> Any:
         return self.traj.layout.slot(self.name)
