@@ -69,10 +69,24 @@ def test_every_tutorial_is_covered_here():
     assert {p.name for p in TUTORIALS.glob("*.py")} == set(CHECKS), "add a check for each"
 
 
+#: What a tutorial leaves in the folder it is run from, for the reader to open afterwards.
+LEAVES = {
+    "t5_own_scenario.py": [
+        "gmuk-out/tennis-racket/view.html",
+        "gmuk-out/tennis-racket/summary.json",
+    ],
+}
+
+
 @pytest.mark.parametrize("name", sorted(CHECKS))
-def test_tutorial_runs_quick(name, capsys):
+def test_tutorial_runs_quick(name, capsys, tmp_path, monkeypatch):
     if name in NEEDS:
         require_distribution(*NEEDS[name])
+    monkeypatch.chdir(tmp_path)  # what a tutorial writes lands here, not in the repository
     result = run(name)
     assert CHECKS[name](result), result
-    assert capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert printed
+    for path in LEAVES.get(name, []):
+        assert (tmp_path / path).is_file(), path
+        assert str((tmp_path / path).parent.resolve()) in printed  # it says where

@@ -13,9 +13,11 @@ registers it::
 Once the package is installed, ``gmuk list`` shows it, ``gmuk run tennis-racket --help``
 lists its options and ``gmuk run tennis-racket --duration 60`` runs it like any thesis
 scenario: trajectory.npz, summary.json, its figure and the 3-D view.html. This script does
-exactly that, in a temporary folder, and reads the summary back.
+exactly that, into ``gmuk-out/tennis-racket`` in the current folder (``gmuk run``'s own
+default; ``--out DIR`` for another), reads the summary back, and prints where the run is, so
+that you can open its view.html and figure afterwards.
 
-Run: python examples/tutorials/t5_own_scenario.py [--quick]
+Run: python examples/tutorials/t5_own_scenario.py [--quick] [--out DIR]
 """
 
 from __future__ import annotations
@@ -24,7 +26,6 @@ import argparse
 import json
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 
@@ -39,6 +40,12 @@ def gmuk(*args: str) -> str:
 def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="a short run (for the tests)")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("gmuk-out") / "tennis-racket",
+        help="output folder (default: gmuk-out/tennis-racket in the current folder)",
+    )
     args = parser.parse_args(argv)
     duration = "30" if args.quick else "120"
 
@@ -46,11 +53,10 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     if not listed:
         sys.exit("tennis-racket is not installed: pip install -e plugins/gmuk-tutorial")
     print(listed[0])
-    with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "racket"
-        print(gmuk("run", "tennis-racket", "--duration", duration, "--out", str(out)))
-        summary = json.loads((out / "summary.json").read_text())
-        files = sorted(p.name for p in out.iterdir())
+    out = args.out
+    print(gmuk("run", "tennis-racket", "--duration", duration, "--out", str(out)))
+    summary = json.loads((out / "summary.json").read_text())
+    files = sorted(p.name for p in out.iterdir())
     result = {
         "flips": float(summary["flips"]),
         "energy_drift": float(summary["energy_drift"]),
@@ -60,6 +66,8 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     }
     for k, v in result.items():
         print(f"{k:>22}: {v:.3g}")
+    print(f"\nThe run is in {out.resolve()}: {', '.join(files)}")
+    print(f"Open {(out / 'view.html').resolve()} in a browser to watch the body flip.")
     return result
 
 
