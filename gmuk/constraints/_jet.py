@@ -31,6 +31,9 @@ Taylor propagation); the seeds on SE(3) are the series of ``g exp(Σ εₖ eₖ^
 
 from __future__ import annotations
 
+import itertools
+import os
+import traceback
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -39,7 +42,15 @@ import numpy as np
 from gmuk._validation import FloatArray
 from gmuk.lie import se3
 
-__all__ = ["Jet", "JetUnsupported", "as_jet", "seed_pose", "seed_scalar", "seed_vector"]
+__all__ = [
+    "Jet",
+    "JetUnsupported",
+    "as_jet",
+    "seed_pose",
+    "seed_scalar",
+    "seed_vector",
+    "where_raised",
+]
 
 
 _ALL = slice(None)
@@ -125,6 +136,19 @@ def seed_scalar(t: float, n_parts: int) -> Jet:
     data[0] = t
     data[-2] = 1.0
     return Jet(data)
+
+
+def where_raised(exc: BaseException, caller: str) -> str:
+    """`` (in name, file:line: code)`` of the frame of ``exc``'s traceback just inside the
+    module ``caller`` (a file path): the line of the residual that stopped the jets; empty
+    when there is none."""
+    caller = os.path.abspath(caller)
+    frames = traceback.extract_tb(exc.__traceback__)
+    for outer, inner in itertools.pairwise(frames):
+        if os.path.abspath(outer.filename) == caller != os.path.abspath(inner.filename):
+            where = f"{os.path.basename(inner.filename)}:{inner.lineno}"
+            return f" (in {inner.name}, {where}: {inner.line})"
+    return ""
 
 
 def as_jet(result: Any, n_parts: int) -> Jet | None:

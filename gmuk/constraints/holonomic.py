@@ -205,7 +205,7 @@ class _Differentiable(Constraint):
                 result = call()
                 jet = _jet.as_jet(result, n_parts)
         except Exception as exc:  # any failure while tracing: the floats decide (_settle)
-            return None, f"{type(exc).__name__}: {exc}"
+            return None, f"{type(exc).__name__}: {exc}{_jet.where_raised(exc, __file__)}"
         if jet is None:
             return None, f"a result without derivatives ({type(result).__name__})"
         if not np.isfinite(jet.data).all():
