@@ -598,3 +598,37 @@ def test_jets_refuse_to_become_floats_and_compare_by_value():
     assert a.shape == () and bool(b < 0)
     with pytest.raises(_jet.JetUnsupported, match=r"numpy\.linalg\.inv"):
         np.linalg.inv(np.outer(x, x))
+
+
+POSE_EXPRESSIONS = {
+    "rotation product": lambda g, t: (g[:3, :3].T @ g[:3, :3] @ M).ravel() * (1.0 + t),
+    "angle": lambda g, t: np.array([np.arccos(0.999 * (np.trace(g[:3, :3]) - 1.0) / 2.0)]),
+    "axes": lambda g, t: np.array([g[:3, 0] @ g[:3, 1] + np.cross(g[:3, 0], g[:3, 2])[1]]),
+    "homogeneous": lambda g, t: (g @ np.array([0.1, -0.2, 0.3, 1.0]))[:3] - np.sin(t),
+    "pose product": lambda g, t: (g @ g)[:3, 3] + np.linalg.norm(g[:3, 3]) * np.cos(2.0 * t),
+    "euler-like": lambda g, t: np.array(
+        [np.arctan2(g[2, 1], g[2, 2]), np.arcsin(np.clip(-g[2, 0], -1.0, 1.0)), t**2 * g[0, 3]]
+    ),
+    "columns": lambda g, t: np.concatenate([g[:3, 3], np.hstack([g[0, :3], 1.0])]) / (2.0 + t),
+    "advanced index": lambda g, t: g[[0, 2], 3] * g[:3, :3][np.array([1, 0]), [2, 1]],
+}
+
+
+@pytest.mark.parametrize("name", sorted(POSE_EXPRESSIONS))
+def test_residuals_of_a_pose_match_finite_differences(name):
+    f = POSE_EXPRESSIONS[name]
+
+    class User(gmuk.HolonomicConstraint):
+        def residual(self, q, t):
+            return f(q[0], t)
+
+    rng = np.random.default_rng(11)
+    exact, fd = User(["bob"]), User(["bob"], derivatives="fd")
+    for _ in range(5):
+        g = np.eye(4)
+        g[:3, :3], g[:3, 3] = so3.exp(0.5 * rng.normal(size=3)), rng.normal(size=3)
+        V, t = rng.normal(size=6), float(rng.uniform(0.1, 1.0))
+        close(exact.jacobian((g,), t), fd.jacobian((g,), t), 1e-7)
+        close(exact.rate((g,), (V,), t), fd.rate((g,), (V,), t), 1e-7)
+        close(exact.bias((g,), (V,), t), fd.bias((g,), (V,), t), 1e-6)
+    assert exact.jet_fallback is None
