@@ -54,8 +54,9 @@ def test_a_completed_run_says_success(tmp_path):
 
 def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_result(tmp_path):
     out = tmp_path / "killed"
+    # 4 orbits (about 3 s compiled), a checkpoint every 0.3 s: killed after a few of them
     proc = subprocess.Popen(
-        _maintenance(out, "10", "--no-plots", "--checkpoint-every", "1", "--compare", "false"),
+        _maintenance(out, "4", "--no-plots", "--checkpoint-every", "0.3", "--compare", "false"),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
     )
@@ -63,7 +64,7 @@ def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_resu
     deadline = time.monotonic() + 60.0
     while not checkpoint.exists() and time.monotonic() < deadline:
         time.sleep(0.2)
-    time.sleep(1.5)  # a checkpoint or two further into the run
+    time.sleep(0.7)  # a checkpoint or two further into the run
     assert proc.poll() is None, proc.communicate()
     proc.send_signal(signal.SIGKILL)
     proc.communicate(timeout=60)
@@ -71,7 +72,7 @@ def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_resu
     assert not (out / "trajectory.npz").exists()
     partial = gmuk.load_trajectory(checkpoint)  # readable: written atomically
     assert partial.stats["checkpoint"]["complete"] is False
-    assert 0.0 < partial.t[-1] < 10 * 7071.0
+    assert 0.0 < partial.t[-1] < 4 * 7071.0
     resumed = subprocess.run(
         [sys.executable, "-m", "gmuk.cli", "run", "--resume", str(out)],
         capture_output=True,
@@ -84,7 +85,7 @@ def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_resu
     assert summary["status"] == "success" and summary["options"]["compare"] is False
     from gmuk.scenarios import maintenance
 
-    plain = maintenance.run(orbits=10.0, compare=False).trajectories["maintenance"]
+    plain = maintenance.run(orbits=4.0, compare=False).trajectories["maintenance"]
     back = gmuk.load_trajectory(out / "trajectory.npz")
     np.testing.assert_array_equal(back.t, plain.t)
     np.testing.assert_allclose(back.r_N, plain.r_N, rtol=0, atol=1e-6)
@@ -92,9 +93,9 @@ def test_a_killed_run_resumes_from_its_last_checkpoint_to_the_uninterrupted_resu
 
 def test_a_stop_ends_every_simulation_of_a_scenario_and_resume_completes_them(tmp_path):
     out = tmp_path / "three"
-    # 20 orbits: the primary run takes about 8 s compiled; the signal comes once it has
-    # written its first checkpoint (after about 1 s of it), well before its end
-    cmd = _maintenance(out, "20", "--no-plots", "--checkpoint-every", "1")
+    # 5 orbits: the primary run takes about 3 s compiled; the signal comes once it has
+    # written its first checkpoint (after 0.3 s of it), well before its end
+    cmd = _maintenance(out, "5", "--no-plots", "--checkpoint-every", "0.3")
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 120.0
     while not (out / ".checkpoints" / "run-0.npz").exists() and time.monotonic() < deadline:
