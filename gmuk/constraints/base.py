@@ -42,8 +42,14 @@ ROWS_KERNEL = numba_types.int64(numba_types.float64, C2, C1, C2, C1, C1, C2, C1)
 #: ``__init__`` names them (:meth:`Constraint.__init_subclass__`), with the default of every
 #: kind that takes them: ``name`` (every kind); ``baumgarte`` (the residual kinds — holonomic,
 #: nonholonomic, inequality — and the tracking and relative constraints); ``fd_length`` and
-#: ``fd_time`` (the residual kinds).
-BASE_KEYWORDS: dict[str, Any] = {"name": None, "baumgarte": None, "fd_length": 1.0, "fd_time": 1.0}
+#: ``fd_time`` (the residual kinds); ``derivatives`` (holonomic and nonholonomic).
+BASE_KEYWORDS: dict[str, Any] = {
+    "name": None,
+    "baumgarte": None,
+    "fd_length": 1.0,
+    "fd_time": 1.0,
+    "derivatives": "jets",
+}
 
 
 @dataclass(frozen=True)
@@ -96,7 +102,8 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
 
     **Keywords of the base class.** A subclass takes the keywords of the gmuk kind it builds
     on (:data:`BASE_KEYWORDS`: ``name`` for every kind; ``baumgarte`` where the kind applies
-    Baumgarte gains; ``fd_length``, ``fd_time`` for the residual kinds) even when its own
+    Baumgarte gains; ``fd_length``, ``fd_time`` for the residual kinds, ``derivatives`` for
+    the holonomic and nonholonomic ones) even when its own
     ``__init__`` does not name them: the class holds them back from that ``__init__`` and hands
     them to the kind's ``__init__`` when ``super().__init__(...)`` reaches it, so the instance
     has them from then on, exactly as if they had been forwarded. A keyword that the

@@ -181,8 +181,8 @@ class _Differentiable(Constraint):
         name: str | None = None,
     ) -> None:
         super().__init__(bodies, name=name)
-        baumgarte, fd_length, fd_time = self._keywords(
-            baumgarte=baumgarte, fd_length=fd_length, fd_time=fd_time
+        baumgarte, fd_length, fd_time, derivatives = self._keywords(
+            baumgarte=baumgarte, fd_length=fd_length, fd_time=fd_time, derivatives=derivatives
         )
         if not (fd_length > 0 and fd_time > 0):
             raise ConstraintError(f"fd_length and fd_time must be > 0; got {fd_length}, {fd_time}")

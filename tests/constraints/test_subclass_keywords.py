@@ -1,7 +1,8 @@
 """The keywords of a constraint's base class (``name``, ``baumgarte``, ``fd_length``,
-``fd_time``; :data:`gmuk.constraints.base.BASE_KEYWORDS`) reach it whether or not a user
-subclass's ``__init__`` forwards them (issue #26, item 6): ``Distance(..., baumgarte=...)`` with
-the quickstart's own ``Distance`` class, exactly as docs/quickstart.rst writes it.
+``fd_time``, ``derivatives``; :data:`gmuk.constraints.base.BASE_KEYWORDS`) reach it whether
+or not a user subclass's ``__init__`` forwards them (issue #26, item 6):
+``Distance(..., baumgarte=...)`` with the quickstart's own ``Distance`` class, exactly as
+docs/quickstart.rst writes it.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import pytest
 from helpers import ScrewReference, random_rigid_bodies, random_state
 
 import gmuk
-from gmuk.errors import DefinitionError
+from gmuk.errors import ConstraintError, DefinitionError
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "docs" / "quickstart.rst"
 
@@ -114,6 +115,22 @@ def test_the_quickstart_distance_takes_the_keywords_it_does_not_forward():
     assert not np.allclose(b1, b0 - 8.0 * rate - 14.0 * phi)
 
 
+def test_the_quickstart_distance_takes_the_derivatives_keyword_it_does_not_forward():
+    """``derivatives="fd"`` reaches the residual kind: its rows are the finite differences',
+    which differ from the exact (jet) rows by their truncation error, and no more."""
+    rng, a, b = two_bodies()
+    p = np.array([0.1, -0.2, 0.3])
+    exact, fd = Distance(a, b, p, -p, 1.5), Distance(a, b, p, -p, 1.5, derivatives="fd")
+    assert (exact.derivatives, fd.derivatives) == ("jets", "fd")
+    state = random_state(gmuk.System([a, b], [exact]), rng)
+    (A0, b0), (A1, b1) = rows_at(exact, state), rows_at(fd, state)
+    assert not np.array_equal(b0, b1)  # another method ...
+    np.testing.assert_allclose(A1, A0, rtol=1e-7, atol=1e-7)  # ... for the same rows
+    np.testing.assert_allclose(b1, b0, rtol=1e-6, atol=1e-6)
+    with pytest.raises(ConstraintError, match="derivatives must be 'jets' or 'fd'"):
+        Distance(a, b, p, -p, 1.5, derivatives="symbolic")
+
+
 def test_a_subclass_that_forwards_the_keywords_gets_them_once():
     rng, a, b = two_bodies()
     fwd = ForwardingDistance(a, b, 1.0, baumgarte=GAINS, name="fwd")
@@ -155,11 +172,12 @@ def test_help_and_ides_see_the_keywords():
         "baumgarte",
         "fd_length",
         "fd_time",
+        "derivatives",
     ]
     assert all(params[k].kind is inspect.Parameter.KEYWORD_ONLY for k in list(params)[5:])
     assert params["fd_length"].default == 1.0 and params["baumgarte"].default is None
     assert list(inspect.signature(ForwardingDistance).parameters) == [
-        "a", "b", "d", "baumgarte", "name", "fd_length", "fd_time",
+        "a", "b", "d", "baumgarte", "name", "fd_length", "fd_time", "derivatives",
     ]  # fmt: skip
     assert list(inspect.signature(Rows).parameters) == ["bodies", "A", "b", "name"]
 
