@@ -10,6 +10,21 @@ from gmuk.lie import se3
 from gmuk.reference import ReferenceState, ReferenceTrajectory
 
 
+class Distance(gmuk.HolonomicConstraint):
+    """|x_a − x_b|² = d² for body points p_a, p_b (m, body frames) of two rigid bodies: the
+    quickstart's residual constraint, written by a user in a few lines."""
+
+    def __init__(self, a, b, p_a, p_b, d, **kw):
+        super().__init__([a, b], **kw)
+        self.p_a, self.p_b, self.d = np.asarray(p_a), np.asarray(p_b), d
+
+    def residual(self, q, t):
+        g_a, g_b = q
+        x_a = g_a[:3, :3] @ self.p_a + g_a[:3, 3]
+        x_b = g_b[:3, :3] @ self.p_b + g_b[:3, 3]
+        return np.array([(x_a - x_b) @ (x_a - x_b) - self.d**2])
+
+
 class Rows(gmuk.Constraint):
     """The lowest-level user constraint of the issue's API: fixed rows."""
 

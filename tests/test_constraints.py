@@ -5,24 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import ScrewReference, random_rigid_bodies, random_state
+from helpers import Distance, ScrewReference, random_rigid_bodies, random_state
 
 import gmuk
 from gmuk.lie import se3, so3
-
-
-class Distance(gmuk.HolonomicConstraint):
-    """|x_a − x_b|² = d² for body points p_a, p_b: written by a user in a few lines."""
-
-    def __init__(self, a, b, p_a, p_b, d, **kw):
-        super().__init__([a, b], **kw)
-        self.p_a, self.p_b, self.d = np.asarray(p_a), np.asarray(p_b), d
-
-    def residual(self, q, t):
-        g_a, g_b = q
-        x_a = g_a[:3, :3] @ self.p_a + g_a[:3, 3]
-        x_b = g_b[:3, :3] @ self.p_b + g_b[:3, 3]
-        return np.array([(x_a - x_b) @ (x_a - x_b) - self.d**2])
 
 
 def distance_rows_by_hand(state, a, b, p_a, p_b):

@@ -15,7 +15,7 @@ import warnings
 import mpmath
 import numpy as np
 import pytest
-from helpers import random_rigid_bodies, random_state
+from helpers import Distance, random_rigid_bodies, random_state
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -60,20 +60,6 @@ class Pinned(gmuk.HolonomicConstraint):
 def pinned_rows(g, V):
     J, acc = point_velocity_rows(g, V, np.array([0.0, 0.0, 0.5]))
     return J, -acc
-
-
-class Distance(gmuk.HolonomicConstraint):
-    """|x_a − x_b|² = d² between body points of two rigid bodies (the quickstart's)."""
-
-    def __init__(self, a, b, p_a, p_b, d, **kw):
-        super().__init__([a, b], **kw)
-        self.p_a, self.p_b, self.d = np.asarray(p_a), np.asarray(p_b), d
-
-    def residual(self, q, t):
-        g_a, g_b = q
-        x_a = g_a[:3, :3] @ self.p_a + g_a[:3, 3]
-        x_b = g_b[:3, :3] @ self.p_b + g_b[:3, 3]
-        return np.array([np.dot(x_a - x_b, x_a - x_b) - self.d**2])
 
 
 def distance_rows(g_a, g_b, V_a, V_b, p_a, p_b):

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import ScrewReference, random_rigid_bodies, random_state
+from helpers import Rows, ScrewReference, random_rigid_bodies, random_state
 
 import gmuk
 from gmuk.errors import ConstraintError, DefinitionError
@@ -67,17 +67,6 @@ class SetsItsOwnGains(Distance):
         gmuk.HolonomicConstraint.__init__(self, [a, b], baumgarte=self.GAINS)
         self.p_a = self.p_b = np.zeros(3)
         self.d = 1.0
-
-
-class Rows(gmuk.Constraint):
-    """The quickstart's lowest-level constraint: rows given directly."""
-
-    def __init__(self, bodies, A, b):
-        super().__init__(bodies)
-        self.A, self.b = A, b
-
-    def rows(self, state):
-        return self.A, self.b
 
 
 def two_bodies(seed=3):
