@@ -213,6 +213,9 @@ def fully_constrained_summary(traj: Trajectory, orbit: KeplerOrbit) -> dict[str,
             ).max()
         ),
         "simulated_translational_constraint_force_max_N": float(sim.max()),
+        "max_constraint_force_deviation_from_nominal_N": float(
+            np.linalg.norm(view.constraint_force[:, 3:] - nominal[:, 3:], axis=1).max()
+        ),
         "max_constraint_torque_deviation_from_nominal_N_m": float(
             np.abs(view.constraint_force[:, :3] - nominal[:, :3]).max()
         ),

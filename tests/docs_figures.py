@@ -1,0 +1,1246 @@
+"""The registry of every result figure the docs quote from a gmuk run (issue #26, item 5).
+
+Each :class:`Figure` says where a number is printed (the doc file, the exact text, and
+optionally a ``near`` text that must come on the same line or up to :data:`WINDOW` lines
+before it), where it comes from (a run of :data:`RUNS` and a key of its ``summary.json``, or
+a function of :data:`DERIVED` of the run's result) and how it is printed (a Python format
+template with one field, :func:`render`). ``tests/test_docs_figures.py`` checks that every
+text is in its doc, reruns each source once per session and checks that every text is what
+the code prints now — it fails when the code's numbers move or a doc is edited.
+
+Two kinds of entries:
+
+* ``kind="equal"`` (the default): the text must equal ``render(value)``;
+* ``kind="below"``: for round-off-level figures (about 1e-13 and below, which move in their
+  first digit whenever the engine's order of operations changes) the doc prints a bound
+  such as "< 2e-15" and the check is that the value's magnitude is below that bound. The
+  text must still equal the rendered bound.
+
+Not in the equality checks, by the explicit lists below: :data:`TIMINGS` (wall times,
+µs, speed ratios: they depend on the machine and its load; the doc names the machine and
+the command, and ``benchmarks/README.md`` keeps the diary) and :data:`ALLOWED` (numbers
+that are not results: the thesis's inputs and gmuk's chosen settings, and history).
+Each of both must still appear in its doc.
+
+The coverage guard (``test_every_result_like_number_is_registered``) scans the pages of
+:data:`GUARDED` with the heuristic of :func:`result_like_numbers`; a number it finds that no
+entry of the three lists covers fails the test.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: lines before a Figure's text within which its ``near`` text must appear
+WINDOW = 14
+
+#: runs that take longer than this (s, on the 2-core machine) are checked under -m slow
+SLOW_S = 20.0
+
+
+@dataclass(frozen=True)
+class Run:
+    """A scenario run: ``gmuk run SCENARIO --OPTION VALUE ...`` (options as on the command
+    line, without ``--``, underscores for dashes), or ``function`` for a script's numbers
+    (it returns a dict like a summary). ``seconds``: its wall time here, about."""
+
+    scenario: str
+    options: dict[str, str] = field(default_factory=dict)
+    seconds: float = 5.0
+    function: Callable[[], dict[str, Any]] | None = None
+
+    @property
+    def slow(self) -> bool:
+        return self.seconds > SLOW_S
+
+
+@dataclass(frozen=True)
+class Figure:
+    doc: str
+    text: str
+    run: str
+    key: str
+    fmt: str
+    near: str = ""
+    kind: str = "equal"
+    offset: float | None = None
+
+
+# --- formatting --------------------------------------------------------------------------------
+
+
+def _normal(s: str) -> str:
+    """Python's format output as the docs print numbers: exponents without padding or '+'
+    (1.2e-8, 3e4), a negative number's minus as U+2212 (an exponent keeps '-'), thousands
+    separated by a space."""
+    s = re.sub(r"e([+-])0*(\d)", lambda m: "e" + ("-" if m.group(1) == "-" else "") + m.group(2), s)
+    s = re.sub(r"(?<![\de])-(?=\d)", "−", s)
+    return re.sub(r"(?<=\d),(?=\d{3})", " ", s)
+
+
+def render(value: float, fmt: str, offset: float | None = None) -> str:
+    """The text a figure prints: ``fmt`` (a template with one format field, e.g.
+    ``"{:.1e} m"``) applied to ``value``; with ``offset`` c, "c + d" or "c − d" of the
+    difference d = value − c (as in "5 + 2.9e-11")."""
+    if offset is not None:
+        d = value - offset
+        return f"{offset:g} {'+' if d >= 0 else '−'} " + _normal(fmt.format(abs(d)))
+    return _normal(fmt.format(value))
+
+
+def bound_of(text: str) -> float:
+    """The number of a "below" figure's text ("< 2e-15 rad" → 2e-15)."""
+    m = re.search(r"[<≤±]\s*([0-9.]+(?:e-?\d+)?)", text)
+    if m is None:
+        raise ValueError(f"a 'below' figure must print '< X', '≤ X' or '± X'; got {text!r}")
+    return float(m.group(1))
+
+
+# --- sources -----------------------------------------------------------------------------------
+
+
+def _optimize_table() -> dict[str, Any]:
+    """docs/optimize.rst's refinement tables (benchmarks/bench_optimize.py --table): the
+    bounded SMD (1 m ≤ x ≤ 2 m, 30 s, degree 3) on uniform meshes and adaptively refined."""
+    from gmuk.optimize import Mesh, OptimalControlProblem
+    from gmuk.scenarios import smd
+
+    system, state = smd.build("smd-bi")
+    problem = OptimalControlProblem(system, state, 30.0)
+    out: dict[str, Any] = {}
+    for n in (10, 20, 40, 80, 150, 300, 600):
+        r = problem.solve(Mesh.uniform(0.0, 30.0, n, 3))
+        out[f"uniform_{n}/objective"] = r.objective
+        out[f"uniform_{n}/iterations"] = r.iterations
+        out[f"uniform_{n}/nodes"] = r.mesh.n_nodes
+    refined = problem.solve_adaptive(Mesh.uniform(0.0, 30.0, 10, 3), tol=1e-6)
+    for i, s in enumerate(refined.refinement):
+        out[f"adaptive_{i}/elements"] = s.n_elements
+        out[f"adaptive_{i}/objective"] = s.objective
+        out[f"adaptive_{i}/max_error"] = s.max_error
+    out["uniform_1200/objective"] = problem.solve(Mesh.uniform(0.0, 30.0, 1200, 3)).objective
+    for tol in (1e-8, 1e-9):
+        last = problem.solve_adaptive(Mesh.uniform(0.0, 30.0, 10, 3), tol=tol).refinement[-1]
+        out[f"adaptive_{tol:.0e}/objective"] = last.objective
+        out[f"adaptive_{tol:.0e}/elements"] = last.n_elements
+        out[f"adaptive_{tol:.0e}/max_error"] = last.max_error
+    best = out["adaptive_1e-08/objective"]
+    out["adaptive_1e-08/agreement"] = abs(out["adaptive_1e-09/objective"] / best - 1.0)
+    out["adaptive_150/relative_error"] = abs(out[f"adaptive_{i}/objective"] / best - 1.0)
+    out["uniform_150/relative_error"] = abs(out["uniform_150/objective"] / best - 1.0)
+    return out
+
+
+def _thesis_nodes_run() -> dict[str, Any]:
+    """smd-compare's SMD-BI on one element of degree 4 (the thesis's five nodes; the
+    extremes of x between the nodes are ``x_direct_collocation_*``), and how far its
+    objective is above the converged one (adaptive refinement to 1e-8)."""
+    from gmuk.optimize import Mesh, OptimalControlProblem
+    from gmuk.scenarios import smd, smd_compare
+
+    out = dict(smd_compare.compare_case("smd-bi", elements=1, degree=4)["summary"])
+    system, state = smd.build("smd-bi")
+    converged = OptimalControlProblem(system, state, 30.0).solve_adaptive(
+        Mesh.uniform(0.0, 30.0, 10, 3), tol=1e-8
+    )
+    out["converged_objective"] = converged.objective
+    out["above_converged_percent"] = 100.0 * (
+        out["objective_direct_quadrature"] / converged.objective - 1.0
+    )
+    return out
+
+
+def _fcei_reference() -> dict[str, Any]:
+    """The FCEI reference's turn rate ‖ω_d‖ over one orbit (rad/s), and how many times the
+    Baumgarte ω_n = 1e-3 s⁻¹ exceeds it."""
+    from gmuk.scenarios import _lvlh, fcei
+
+    orbit = fcei.fcei_orbit(_lvlh.MU)
+    ref = _lvlh.LVLHReference(orbit).evaluate_many(np.linspace(0.0, orbit.period, 2001))
+    rate = np.linalg.norm(ref.V[:, :3], axis=1)
+    omega_n = 1e-3
+    return {
+        "turn_rate_min": rate.min(),
+        "turn_rate_max": rate.max(),
+        "omega_n_over_max": omega_n / rate.max(),
+        "omega_n_over_min": omega_n / rate.min(),
+    }
+
+
+def _fcei_unstabilised() -> dict[str, Any]:
+    """FCEI without Baumgarte terms (the thesis's bare Eq. 67 rows) over six orbits: the
+    attitude error after one and after three orbits (rad), its growth per orbit between
+    them (the exponent), after six orbits, and how many times ω_n = 1e-3 s⁻¹ exceeds the
+    growth rate."""
+    from gmuk.errors import GmukWarning
+    from gmuk.scenarios import _lvlh, fcei
+
+    orbit = fcei.fcei_orbit(_lvlh.MU)
+    with warnings.catch_warnings():  # it drifts, as it should: that is the point
+        warnings.simplefilter("ignore", GmukWarning)
+        traj = _lvlh.fully_constrained(orbit, 6.0, baumgarte=None)
+    _, att = _lvlh.reference_errors(traj, orbit)
+    n = traj.t / orbit.period
+
+    def at(k: float) -> float:
+        return float(att[np.argmin(np.abs(n - k))])
+
+    growth = float(np.log(at(3.0) / at(1.0)) / 2.0)
+    return {
+        "attitude_error_1_orbit_rad": at(1.0),
+        "attitude_error_3_orbits_rad": at(3.0),
+        "attitude_error_6_orbits_rad": at(6.0),
+        "growth_exponent_per_orbit": growth,
+        "omega_n_over_growth_rate": 1e-3 / (growth / orbit.period),
+        "period_s": orbit.period,
+    }
+
+
+RUNS: dict[str, Run] = {
+    "fcei": Run("fcei", seconds=3),
+    "fccn": Run("fccn", seconds=2),
+    "fceim": Run("fceim", seconds=4),
+    "fcei-12": Run("fcei", {"orbits": "12"}, seconds=9),
+    "fcei-reference": Run("(the FCEI reference)", seconds=1, function=_fcei_reference),
+    "fcei-unstabilised": Run(
+        "(fully_constrained(..., baumgarte=None))", seconds=5, function=_fcei_unstabilised
+    ),
+    "fceim-12": Run("fceim", {"orbits": "12"}, seconds=80),
+    "uceim-12": Run("uceim", {"orbits": "12"}, seconds=170),
+    "ucei": Run("ucei", seconds=3),
+    "uceis": Run("uceis", seconds=3),
+    "uceim": Run("uceim", seconds=5),
+    "smd-gt": Run("smd-gt", seconds=3),
+    "smd-lt": Run("smd-lt", seconds=1),
+    "smd-bi": Run("smd-bi", seconds=2),
+    "smd-gt-damped": Run("smd-gt", {"slack_damping": "20"}, seconds=1),
+    "smd-bi-damped": Run("smd-bi", {"slack_damping": "20"}, seconds=1),
+    "smd-compare": Run("smd-compare", seconds=9),
+    "smd-compare-thesis-nodes": Run("smd-compare", seconds=2, function=_thesis_nodes_run),
+    "maintenance": Run("maintenance", seconds=26),
+    "maintenance-40": Run(
+        "maintenance",
+        {"orbits": "40", "velocity_bound": "0", "compare": "false"},
+        seconds=90,
+    ),
+    "maintenance-slack-120": Run(
+        "maintenance", {"slack_mass": "120", "compare": "false"}, seconds=90
+    ),
+    "optimize-table": Run(
+        "(benchmarks/bench_optimize.py --table)", seconds=25, function=_optimize_table
+    ),
+}
+
+
+# --- derived figures: functions of a run's result (not in summary.json) ---------------------
+# A key "fn:NAME" or "fn:NAME:ARG" calls DERIVED[NAME](result, ARG) (ARG a string, "" if none).
+
+
+def _smd(result: Any) -> tuple[Any, Any, Any, Any]:
+    from gmuk.scenarios import smd
+
+    traj = result.trajectories[result.primary]
+    return traj.t, traj.r_N[:, 0, 0], smd.control_acceleration(traj), result.data["kkt"]
+
+
+def _smd_peak(result: Any, what: str) -> float:
+    """u at its largest magnitude ("u"), that time ("t"), u's maximum ("max"), minimum
+    ("min"), first value ("start") (m/s², s)."""
+    t, _, u, _ = _smd(result)
+    i = int(np.argmax(np.abs(u)))
+    return {"u": u[i], "t": t[i], "max": u.max(), "min": u.min(), "start": u[0]}[what]
+
+
+def _smd_mu(result: Any, arg: str) -> float:
+    """ARG "SIDE:what", of bound x.SIDE: its smallest μ ("min"), that time ("t_min"), μ at
+    t = 0 ("start"), the distance of x from the bound there ("gap_at_min"), the first and
+    last times of the first interval where μ < 0 ("t_first_negative", "t_end_first_negative")
+    (N, s, m)."""
+    side, what = arg.split(":")
+    t, _, _, kkt = _smd(result)
+    b = kkt.inequalities[f"x.{side}"]
+    j = int(np.argmin(b.mu))
+    negative = np.flatnonzero(b.mu < 0)
+    first = negative[0] if negative.size else 0
+    end = first
+    while end + 1 < t.size and b.mu[end + 1] < 0:
+        end += 1
+    return {
+        "min": b.mu[j],
+        "t_min": t[j],
+        "start": b.mu[0],
+        "gap_at_min": abs(b.bound - _smd(result)[1][j]),
+        "t_first_negative": t[first] if negative.size else np.nan,
+        "t_end_first_negative": t[end] if negative.size else np.nan,
+    }[what]
+
+
+def _smd_local_max(result: Any, arg: str) -> float:
+    """ARG "T:what" for the local maximum of x nearest T (s): its time ("t"), x there ("x") or
+    its height above the lower bound ("height")."""
+    target, what = arg.split(":")
+    t, x, _, kkt = _smd(result)
+    i = np.flatnonzero((x[1:-1] > x[:-2]) & (x[1:-1] >= x[2:])) + 1
+    k = i[np.argmin(np.abs(t[i] - float(target)))]
+    if what == "height":
+        return x[k] - kkt.inequalities["x.lower"].bound
+    return {"t": t[k], "x": x[k]}[what]
+
+
+def _smd_settled(result: Any, arg: str) -> float:
+    """ARG "LEVEL:TOL": the time from which abs(x − LEVEL) ≤ TOL to the end (s)."""
+    level, tol = map(float, arg.split(":"))
+    t, x, _, _ = _smd(result)
+    away = np.flatnonzero(np.abs(x - level) > tol)
+    return t[away[-1] + 1] if away.size else t[0]
+
+
+def _smd_quiet(result: Any, arg: str) -> float:
+    """The time from which abs(u) < ARG m/s² to the end (s)."""
+    t, _, u, _ = _smd(result)
+    return t[np.flatnonzero(np.abs(u) >= float(arg))[-1] + 1]
+
+
+def _smd_near(result: Any, arg: str) -> float:
+    """ARG "LEVEL:TOL:what": the first time x comes within TOL of LEVEL ("first"), or the start
+    ("from") and end ("to") of the second interval within it (s)."""
+    level, tol, what = arg.split(":")
+    t, x, _, _ = _smd(result)
+    inside = np.abs(x - float(level)) <= float(tol)
+    starts = np.flatnonzero(inside[1:] & ~inside[:-1]) + 1
+    ends = np.flatnonzero(~inside[1:] & inside[:-1])
+    if what == "first":
+        return t[np.flatnonzero(inside)[0]]
+    return {"from": t[starts[1]], "to": t[ends[1]]}[what]
+
+
+def _time_of_max_x(result: Any, _: str) -> float:
+    t, x, _, _ = _smd(result)
+    return t[int(np.argmax(x))]
+
+
+def _maintenance(result: Any, run: str) -> tuple[Any, Any, Any, Any]:
+    """(t in orbits, ‖r_e‖, ‖ṙ_e‖, ‖u‖) of one run of a maintenance result."""
+    from gmuk.scenarios import maintenance
+
+    orbit = result.data["orbit"]
+    traj = result.trajectories[run]
+    e, e_dot = maintenance.errors(traj, orbit)
+    u = np.linalg.norm(traj.body(maintenance.BODY).constraint_force, axis=1) / maintenance.MASS
+    return (
+        traj.t / orbit.period,
+        np.linalg.norm(e, axis=1),
+        np.linalg.norm(e_dot, axis=1),
+        u,
+    )
+
+
+def _m_first_reach(result: Any, arg: str) -> float:
+    """ARG "RUN:LEVEL": the first time (orbits) ‖r_e‖ reaches LEVEL m."""
+    run, level = arg.split(":")
+    t, pos, _, _ = _maintenance(result, run)
+    return t[np.flatnonzero(pos >= float(level))[0]]
+
+
+def _m_orbit_max(result: Any, arg: str) -> float:
+    """ARG "RUN:QUANTITY:K": the largest ‖ṙ_e‖ ("velocity") or ‖r_e‖ ("position") over orbit K
+    (1-based)."""
+    run, quantity, k = arg.split(":")
+    t, pos, vel, _ = _maintenance(result, run)
+    sel = (t >= int(k) - 1) & (t <= int(k))
+    return {"velocity": vel, "position": pos}[quantity][sel].max()
+
+
+def _m_fraction(result: Any, arg: str) -> float:
+    """ARG "WHAT:LEVEL:ORBITS": the fraction (%) of the outputs over the first ORBITS orbits (all
+    if 0) where the velocity bound's μ ("mu_velocity") or ‖u‖ ("u") exceeds LEVEL, or where
+    the position bound's μ is negative ("mu_position_negative", LEVEL unused)."""
+    what, level, orbits = arg.split(":")
+    t, _, _, u = _maintenance(result, "maintenance")
+    sel = t <= float(orbits) if float(orbits) > 0 else np.ones(t.shape, bool)
+    kkt = result.data["kkt_maintenance"].inequalities
+    if what == "u":
+        values = u[sel] > float(level)
+    elif what == "mu_velocity":
+        values = _bound(kkt, "velocity").mu[sel] > float(level)
+    else:
+        values = _bound(kkt, "position").mu[sel] < 0.0
+    return 100.0 * float(np.mean(values))
+
+
+def _bound(inequalities: dict[str, Any], which: str) -> Any:
+    (b,) = [b for name, b in inequalities.items() if which in name]
+    return b
+
+
+def _m_kkt(result: Any, arg: str) -> float:
+    """ARG "RUN:BOUND:what": dual violation ("dual") or max abs(μ g) ("mu_g") of the position or
+    velocity bound of a run."""
+    run, which, what = arg.split(":")
+    b = _bound(result.data[f"kkt_{run}"].inequalities, which)
+    return {"dual": b.dual_violation.max(), "mu_g": np.abs(b.complementarity).max()}[what]
+
+
+def _m_stationarity(result: Any, _: str) -> float:
+    return max(float(v.stationarity.max()) for k, v in result.data.items() if k.startswith("kkt_"))
+
+
+def _m_free_after(result: Any, arg: str) -> float:
+    """‖r_e‖ of the free run after ARG orbits (km)."""
+    t, pos, _, _ = _maintenance(result, "free")
+    return pos[np.argmin(np.abs(t - float(arg)))] / 1e3
+
+
+def _diff(result: Any, arg: str) -> float:
+    """ARG "KEY_A-KEY_B": the difference of two summary figures."""
+    a, b = arg.split("-")
+    return result.summary[a] - result.summary[b]
+
+
+def _ratio(result: Any, arg: str) -> float:
+    """ARG "KEY_A/KEY_B": the ratio of two summary figures."""
+    a, b = arg.split("/")
+    return result.summary[a] / result.summary[b]
+
+
+DERIVED: dict[str, Callable[[Any, str], float]] = {
+    "smd_peak": _smd_peak,
+    "smd_mu": _smd_mu,
+    "smd_local_max": _smd_local_max,
+    "smd_settled": _smd_settled,
+    "smd_quiet": _smd_quiet,
+    "smd_near": _smd_near,
+    "smd_time_of_max_x": _time_of_max_x,
+    "m_first_reach": _m_first_reach,
+    "m_orbit_max": _m_orbit_max,
+    "m_fraction": _m_fraction,
+    "m_kkt": _m_kkt,
+    "m_stationarity": _m_stationarity,
+    "m_free_after_km": _m_free_after,
+    "ratio": _ratio,
+    "diff": _diff,
+}
+
+
+# --- the registry ------------------------------------------------------------------------------
+
+CH4 = "docs/scenarios/chapter4.rst"
+CH6 = "docs/scenarios/chapter6.rst"
+CMP = "docs/scenarios/smd_compare.rst"
+TH6 = "docs/theory/chapter6.rst"
+OPT = "docs/optimize.rst"
+
+FIGURES: list[Figure] = []
+
+#: numbers the guard finds that are not results: (doc, text, why)
+ALLOWED: list[tuple[str, str, str]] = []
+
+#: machine-dependent figures, excluded from equality: (doc, text, where and how measured)
+TIMINGS: list[tuple[str, str, str]] = []
+
+#: results no test reruns yet (history, or runs not wired here): (doc, text, why). Each is a
+#: gap in the check, listed so that it is visible; the goal is an empty list.
+UNREGENERATED: list[tuple[str, str, str]] = []
+
+
+# --- the coverage guard -------------------------------------------------------------------------
+
+#: pages whose result-like numbers are not registered yet: the guard skips them, and says so
+#: (test_the_guard_skips_only_the_listed_pages). The goal is an empty dict.
+NOT_YET_GUARDED: dict[str, str] = {
+    "docs/scenarios/chapter3.rst": "apollo16's tables: not registered yet (issue #26, item 5)",
+    "docs/scenarios/chapter5.rst": "fccl and unmodeled: not registered yet (issue #26, item 5)",
+    "docs/theory/chapter3.rst": "not registered yet (issue #26, item 5)",
+    "docs/theory/chapter5.rst": "not registered yet (issue #26, item 5)",
+}
+
+#: the pages the guard scans: every scenario and theory page but those above
+GUARDED = sorted(
+    str(p.relative_to(ROOT))
+    for pattern in ("docs/scenarios/*.rst", "docs/theory/*.rst")
+    for p in ROOT.glob(pattern)
+    if str(p.relative_to(ROOT)) not in NOT_YET_GUARDED
+)
+
+_UNITS = r"(?:m/s²|m/s|km|mm|m|N·m|N²·s/kg|N|kg|rad/s|rad|J/s|°)"
+_NUM = r"[−-]?\d+(?: \d{3})*(?:\.\d+)?(?:e[−+-]?\d+)?"
+#: a number with a unit of length, speed, acceleration, force, mass, angle; or any number in
+#: scientific notation
+RESULT_LIKE = re.compile(
+    rf"(?<![\w.])(?:{_NUM}(?:\s*/\s*{_NUM})*\s*{_UNITS}(?![\w/])|\d+(?:\.\d+)?e[−+-]?\d+)"
+)
+
+
+def summary_keys() -> set[str]:
+    """The summary.json keys, read from the scenario modules' source: string literals used as
+    dict keys or subscripts (an f-string's ``{prefix}`` dropped), plus the command line's."""
+    keys = {"wall_time_s", "t_reached_s", "constraint_violation"}
+    for path in (ROOT / "gmuk" / "scenarios").glob("*.py"):
+        text = path.read_text(encoding="utf-8")
+        pattern = r"[\"'](?:\{[a-z_]+\})?([a-z][a-z0-9]*(?:_[a-z0-9]+)+)[\"']\s*[:\]]"
+        keys.update(m.group(1) for m in re.finditer(pattern, text))
+    return keys
+
+
+def _blocks(lines: list[str]) -> list[tuple[int, int]]:
+    """RST blocks as (first, end) line indices: a paragraph or a directive with its
+    indented body (blank lines followed by deeper indentation stay in the block)."""
+    out, i, n = [], 0, len(lines)
+    while i < n:
+        if not lines[i].strip():
+            i += 1
+            continue
+        indent = len(lines[i]) - len(lines[i].lstrip())
+        j = i + 1
+        while j < n:
+            if lines[j].strip():
+                if len(lines[j]) - len(lines[j].lstrip()) < indent:
+                    break
+                j += 1
+                continue
+            k = j
+            while k < n and not lines[k].strip():
+                k += 1
+            if k < n and len(lines[k]) - len(lines[k].lstrip()) > indent:
+                j = k
+                continue
+            break
+        out.append((i, j))
+        i = j
+    return out
+
+
+_HEADING = re.compile(r"^([=\-~^\"'`#*+])\1{3,}\s*$")
+
+
+def result_like_numbers(doc: str, keys: set[str]) -> list[tuple[int, int, str]]:
+    """(line index, column, text) of every result-like number of ``doc`` (:data:`RESULT_LIKE`) in a
+    *measured block*: an RST block (:func:`_blocks`) that mentions ``gmuk run``,
+    ``summary.json`` or a summary key (:func:`summary_keys`), or any block of a section whose
+    title starts with "Measured". Image directives are skipped (their alt text describes the
+    picture)."""
+    lines = (ROOT / doc).read_text(encoding="utf-8").splitlines()
+    measured_section = [False] * len(lines)
+    inside = False
+    for i, line in enumerate(lines):
+        if i + 1 < len(lines) and _HEADING.match(lines[i + 1]) and line.strip():
+            inside = line.strip().startswith("Measured")
+        measured_section[i] = inside
+    key_re = re.compile(r"\b(" + "|".join(sorted(map(re.escape, keys))) + r")\b")
+    found = []
+    for a, b in _blocks(lines):
+        block = "\n".join(lines[a:b])
+        if lines[a].lstrip().startswith((".. image::", ".. figure::")):
+            continue  # alt text describes a picture
+        if not (
+            measured_section[a]
+            or "gmuk run" in block
+            or "summary.json" in block
+            or key_re.search(block)
+        ):
+            continue
+        for i in range(a, b):
+            if _HEADING.match(lines[i]):
+                continue
+            found += [(i, m.start(), m.group(0)) for m in RESULT_LIKE.finditer(lines[i])]
+    return found
+
+
+def _add(doc: str, run: str, *rows: tuple[Any, ...]) -> None:
+    """Register rows (text, key, fmt[, near[, kind][, offset]]) of one doc and run."""
+    for row in rows:
+        text, key, fmt, *rest = row
+        near = rest[0] if rest else ""
+        kind = next((x for x in rest[1:] if isinstance(x, str)), "equal")
+        offset = next((float(x) for x in rest[1:] if isinstance(x, (int, float))), None)
+        FIGURES.append(Figure(doc, text, run, key, fmt, near, kind, offset))
+
+
+# docs/scenarios/chapter4.rst ------------------------------------------------------------------
+_add(
+    CH4,
+    "fcei",
+    ("1.2e-8 m", "max_position_error_m", "{:.1e} m", "FCEI position error"),
+    ("< 1e-14 rad", "max_attitude_error_rad", "< {:.0e} rad", "FCEI attitude error", "below"),
+    ("< 1e-18 rad/s", "max_abs_omega1_omega2_rad_s", "< {:.0e} rad/s", "FCEI max", "below"),
+    ("5438 /", "rhs_evaluations", "{} /", "FCEI RHS evaluations"),
+    ("9.3e-11 N", "max_constraint_force_deviation_from_nominal_N", "{:.1e} N"),
+    ("law to 1.4 %", "nominal_force_r4_law_max_relative_deviation*100", "law to {:.1f} %"),
+    (
+        "``nominal_force_r4_law_max_relative_deviation`` 0.0144",
+        "nominal_force_r4_law_max_relative_deviation",
+        "``nominal_force_r4_law_max_relative_deviation`` {:.4f}",
+    ),
+    ("5e-10 N remainder", "nominal_translational_constraint_force_max_N", "{:.0e} N remainder"),
+    ("11474.3 s", "time_of_min_nominal_constraint_force_s", "{:.1f} s"),
+    ("11348.2 s", "aposelene_time_s", "{:.1f} s"),
+    (
+        "minimum 126 s after",
+        "fn:diff:time_of_min_nominal_constraint_force_s-aposelene_time_s",
+        "minimum {:.0f} s after",
+    ),
+    ("up to 9.6e-4 N·m", "max_constraint_torque_N_m", "up to {:.1e} N·m"),
+    (
+        "< 2e-16 N·m",
+        "max_constraint_torque_deviation_from_nominal_N_m",
+        "< {:.0e} N·m",
+        "",
+        "below",
+    ),
+    (
+        "4.8e-10 N at periselene",
+        "nominal_translational_constraint_force_max_N",
+        "{:.1e} N at periselene",
+    ),
+    (
+        "9.4e-11 N at aposelene",
+        "nominal_translational_constraint_force_min_N",
+        "{:.1e} N at aposelene",
+    ),
+)
+_add(
+    CH4,
+    "fccn",
+    ("1.5e-12", "constraint_torque_relative_variation", "{:.1e}", "FCCN constraint-torque"),
+    (
+        "< 1e-14 /",
+        "nominal_constraint_torque_relative_variation",
+        "< {:.0e} /",
+        "FCCN nominal torque",
+        "below",
+    ),
+    (
+        "/ < 1e-14 of gravity",
+        "nominal_constraint_force_variation_over_gravity",
+        "/ < {:.0e} of gravity",
+        "FCCN nominal torque",
+        "below",
+    ),
+    ("varies by 0.8 %", "nominal_force_r4_law_max_relative_deviation*100", "varies by {:.1f} %"),
+)
+_add(
+    CH4,
+    "fceim",
+    ("1.5e-8 m", "max_position_difference_vs_fcei_m", "{:.1e} m", "FCEIM − FCEI position"),
+)
+_add(
+    CH4,
+    "ucei",
+    ("1.8e-8 /", "max_position_difference_vs_fcei_m", "{:.1e} /", "UCEI / UCEIS position"),
+    ("< 1e-14 rad /", "max_locked_rotation_rad", "< {:.0e} rad /", "UCEI locked", "below"),
+    ("/ 5.0e-9 m", "max_locked_translation_m", "/ {:.1e} m", "UCEI locked"),
+    ("0.158 rad", "max_abs_roll_rad", "{:.3f} rad", "UCEI free-axis roll"),
+    ("(1.8e-8 m,", "max_position_difference_vs_fcei_m", "({:.1e} m,", "the orbit itself"),
+    ("difference 0.31,", "translational_constraint_accel_rel_diff_vs_fcei", "difference {:.2f},"),
+    ("1.0e-15 of", "max_locked_translation_over_distance", "{:.1e} of"),
+)
+_add(
+    CH4,
+    "uceis",
+    ("/ 2.4e-8 m", "max_position_difference_vs_fcei_m", "/ {:.1e} m", "UCEI / UCEIS position"),
+    ("3.14 rad", "max_abs_roll_rad", "{:.2f} rad", "UCEIS free-axis roll"),
+)
+_add(
+    CH4,
+    "uceim",
+    ("3.6e-8 m from UCEI", "max_position_difference_vs_ucei_m", "{:.1e} m from UCEI"),
+    (
+        "< 1e-14 rad; Eq. 80's",
+        "max_roll_difference_vs_ucei_rad",
+        "< {:.0e} rad; Eq. 80's",
+        "",
+        "below",
+    ),
+    ("fraction 0.35–", "eq80_unreachable_fraction_min", "fraction {:.2f}–"),
+    ("–0.47", "eq80_unreachable_fraction_max", "–{:.2f}", "Eq. 80's unreachable"),
+)
+_add(
+    CH4,
+    "fcei-12",
+    ("< 1e-13 rad (round-off)", "max_attitude_error_rad", "< {:.0e} rad (round-off)", "", "below"),
+    (
+        "position error 2.7e-7 m, 4153 steps",
+        "max_position_error_m",
+        "position error {:.1e} m, 4153 steps",
+    ),
+    ("4153 steps (6.6 s", "steps", "{} steps (6.6 s"),
+)
+_add(
+    CH4,
+    "fceim-12",
+    (
+        "< 1e-13 rad / 2.8e-7 m",
+        "max_attitude_error_rad",
+        "< {:.0e} rad / 2.8e-7 m",
+        "FCEIM attitude",
+        "below",
+    ),
+    ("/ 2.8e-7 m", "max_position_error_m", "/ {:.1e} m", "FCEIM attitude"),
+    ("3.4e-7 m", "max_position_difference_vs_fcei_m", "{:.1e} m", "FCEIM − FCEI position"),
+    ("3921 /", "steps", "{} /", "FCEIM steps"),
+    ("/ 65 414 /", "rhs_evaluations", "/ {:,} /", "FCEIM steps"),
+)
+_add(
+    CH4,
+    "uceim-12",
+    (
+        "< 1e-13 rad",
+        "max_roll_difference_vs_ucei_rad",
+        "< {:.0e} rad",
+        "UCEIM roll difference",
+        "below",
+    ),
+    ("3.3e-7 m", "max_position_difference_vs_ucei_m", "{:.1e} m", "UCEIM − UCEI position"),
+    ("< 1e-13 rad", "max_locked_rotation_rad", "< {:.0e} rad", "UCEIM locked relative", "below"),
+    ("65 726 /", "rhs_evaluations", "{:,} /", "UCEIM RHS evaluations"),
+)
+
+# docs/scenarios/chapter6.rst, spring–mass–damper ----------------------------------------------
+_T = {"smd-gt": "GT", "smd-gt-damped": "GT, damped", "smd-lt": "LT", "smd-bi": "BI"}
+_add(
+    CH6,
+    "smd-gt",
+    ("5 + 2.9e-11", "x_min", "{:.1e}", "x_min (m)", 5.0),
+    ("5.002542", "x_final", "{:.6f}", "x_final (m)"),
+    ("25.354", "control_accel_final", "{:.3f}", "control_accel_final"),
+    ("753.50", "control_effort_final", "{:.2f}", "control_effort_final"),
+    ("25.80", "complementarity_abs_max", "{:.2f}", "complementarity_abs_max"),
+    ("< 2e-15", "stationarity_max", "< {:.0e}", "stationarity_max", "below"),
+    ("32 818", "n_rhs", "{:,}", "RHS evaluations"),
+    ("peak control 378.5 m/s²", "fn:smd_peak:u", "peak control {:.1f} m/s²"),
+    ("first contact, 0.52 s", "fn:smd_peak:t", "first contact, {:.2f} s"),
+    ("onto x = 5 m at 0.52 s", "fn:smd_peak:t", "onto x = 5 m at {:.2f} s"),
+    ("(0.28 m at 2.4 s", "fn:smd_local_max:2.4:height", "({:.2f} m at 2.4 s"),
+    ("m at 2.4 s", "fn:smd_local_max:2.4:t", "m at {:.1f} s", "bounce height"),
+    ("0.029 m at 10.2 s", "fn:smd_local_max:10.2:height", "{:.3f} m at 10.2 s"),
+    ("m at 10.2 s", "fn:smd_local_max:10.2:t", "m at {:.1f} s", "bounce height"),
+    ("0.008 m", "fn:smd_local_max:29.3:height", "{:.3f} m", "0.029 m at 10.2 s"),
+    ("at 29.3 s)", "fn:smd_local_max:29.3:t", "at {:.1f} s)", "0.029 m at 10.2 s"),
+    ("25.35 m/s² at 30 s", "control_accel_final", "{:.2f} m/s² at 30 s"),
+    ("falls from 378.5 to", "fn:smd_peak:u", "falls from {:.1f} to"),
+    ("μ = 3.2 N at t = 0", "fn:smd_mu:lower:start", "μ = {:.1f} N at t = 0"),
+)
+_add(
+    CH6,
+    "smd-gt-damped",
+    ("5 − 3.7e-13", "x_min", "{:.1e}", "x_min (m)", 5.0),
+    ("5 ± 1e-13", "x_final", "5 ± {:.0e}", "x_final (m)", "below", 5.0),
+    ("25.000", "control_accel_final", "{:.3f}", "control_accel_final"),
+    ("747.56", "control_effort_final", "{:.2f}", "control_effort_final"),
+    ("3.7e-13", "primal_violation_max", "{:.1e}", "primal_violation_max"),
+    ("38.50", "complementarity_abs_max", "{:.2f}", "complementarity_abs_max"),
+    ("< 2e-15", "stationarity_max", "< {:.0e}", "stationarity_max", "below"),
+    ("2 530", "n_rhs", "{:,}", "RHS evaluations"),
+    ("67.3 m/s² (GT damped)", "fn:smd_peak:u", "{:.1f} m/s² (GT damped)"),
+    ("to 67.3 m/s²", "fn:smd_peak:u", "to {:.1f} m/s²"),
+    ("within 1 mm from 0.92 s on", "fn:smd_settled:5:1e-3", "within 1 mm from {:.2f} s on"),
+)
+_add(
+    CH6,
+    "smd-lt",
+    ("−0.33856", "x_min", "{:.5f}", "x_min (m)"),
+    ("0.999980", "x_max", "{:.6f}", "x_max (m)"),
+    ("≈ 0 (< 1e-14)", "x_final", "≈ 0 (< {:.0e})", "x_final (m)", "below"),
+    ("≈ 0 (< 1e-13)", "control_accel_final", "≈ 0 (< {:.0e})", "control_accel_final", "below"),
+    ("3.911", "control_effort_final", "{:.3f}", "control_effort_final"),
+    ("0.101", "dual_violation_max", "{:.3f}", "dual_violation_max"),
+    ("1.636", "complementarity_abs_max", "{:.3f}", "complementarity_abs_max"),
+    ("< 2e-15", "stationarity_max", "< {:.0e}", "stationarity_max", "below"),
+    ("2 566", "n_rhs", "{:,}", "RHS evaluations"),
+    ("−19.35 m/s² (LT, at 0.37 s)", "fn:smd_peak:u", "{:.2f} m/s² (LT, at 0.37 s)"),
+    ("(LT, at 0.37 s)", "fn:smd_peak:t", "(LT, at {:.2f} s)"),
+    ("reaches 0.99998 m at 0.36 s", "x_max", "reaches {:.5f} m at 0.36 s"),
+    ("m at 0.36 s", "fn:smd_time_of_max_x", "m at {:.2f} s", "reaches 0.99998"),
+    ("m/s² after 6.3 s", "fn:smd_quiet:1e-3", "m/s² after {:.1f} s"),
+    ("effort 3.911 m/s", "control_effort_final", "effort {:.3f} m/s"),
+    ("(−0.10 N at 2.7 s", "fn:smd_mu:upper:min", "({:.2f} N at 2.7 s"),
+    ("N at 2.7 s", "fn:smd_mu:upper:t_min", "N at {:.1f} s", "The multiplier goes slightly"),
+    ("1 m from the bound", "fn:smd_mu:upper:gap_at_min", "{:.0f} m from the bound"),
+)
+_add(
+    CH6,
+    "smd-bi",
+    ("1 + 1.5e-7", "x_min", "{:.1e}", "x_min (m)", 1.0),
+    ("1.999981", "x_max", "{:.6f}", "x_max (m)"),
+    ("1.006719", "x_final", "{:.6f}", "x_final (m)"),
+    ("4.766", "control_accel_final", "{:.3f}", "control_accel_final"),
+    ("169.24", "control_effort_final", "{:.2f}", "control_effort_final"),
+    ("15.88", "dual_violation_max", "{:.2f}", "dual_violation_max"),
+    ("33.36", "complementarity_abs_max", "{:.2f}", "complementarity_abs_max"),
+    ("< 2e-15", "stationarity_max", "< {:.0e}", "stationarity_max", "below"),
+    ("18 178", "n_rhs", "{:,}", "RHS evaluations"),
+    ("117.9 /", "fn:smd_peak:max", "{:.1f} /", "peak control 378.5"),
+    ("/ −123.1 m/s² (BI)", "fn:smd_peak:min", "/ {:.1f} m/s² (BI)"),
+    ("of 2 m at 0.12 s", "fn:smd_near:2:1e-3:first", "of 2 m at {:.2f} s"),
+    ("from 0.92 s to", "fn:smd_near:2:1e-2:from", "from {:.2f} s to", "where it dwells"),
+    ("to 1.11 s within 1 cm", "fn:smd_near:2:1e-2:to", "to {:.2f} s within 1 cm"),
+    ("(down to −15.9 N,", "fn:smd_mu:upper:min", "(down to {:.1f} N,"),
+    ("between 0.55 s", "fn:smd_mu:upper:t_first_negative", "between {:.2f} s"),
+    ("and 1.35 s)", "fn:smd_mu:upper:t_end_first_negative", "and {:.2f} s)"),
+    ("(+7.5 m/s² without)", "fn:smd_peak:start", "(+{:.1f} m/s² without)"),
+)
+_add(
+    CH6,
+    "smd-bi-damped",
+    ("1 ± 1e-14", "x_min", "1 ± {:.0e}", "x_min (m)", "below", 1.0),
+    ("1.940438", "x_max", "{:.6f}", "x_max (m)"),
+    ("1.000000", "x_final", "{:.6f}", "x_final (m)"),
+    ("5.000", "control_accel_final", "{:.3f}", "control_accel_final"),
+    ("155.22", "control_effort_final", "{:.2f}", "control_effort_final"),
+    ("< 1e-14", "primal_violation_max", "< {:.0e}", "primal_violation_max", "below"),
+    ("15.24", "dual_violation_max", "{:.2f}", "dual_violation_max"),
+    ("25.25", "complementarity_abs_max", "{:.2f}", "complementarity_abs_max"),
+    ("< 2e-15", "stationarity_max", "< {:.0e}", "stationarity_max", "below"),
+    ("3 470", "n_rhs", "{:,}", "RHS evaluations"),
+    ("4.41 s on)", "fn:smd_settled:1:1e-3", "{:.2f} s on)"),
+    ("starts with −32.5 m/s²", "fn:smd_peak:start", "starts with {:.1f} m/s²"),
+    ("(1.940 m)", "x_max", "({:.3f} m)"),
+    ("(upper −15.2 N at 0.36 s", "fn:smd_mu:upper:min", "(upper {:.1f} N at 0.36 s"),
+    ("N at 0.36 s", "fn:smd_mu:upper:t_min", "N at {:.2f} s", "(upper"),
+    ("lower −14.5 N at the start", "fn:smd_mu:lower:start", "lower {:.1f} N at the start"),
+)
+
+# docs/scenarios/chapter6.rst, trajectory maintenance ------------------------------------------
+_add(
+    CH6,
+    "maintenance",
+    ("period 7070.92 s", "period_s", "period {:.2f} s"),
+    ("(ten orbits, 70 709 s)", "period_s*10", "(ten orbits, {:,.0f} s)"),
+    ("68 791", "free_position_error_max_m", "{:,.0f}", "max ‖r_e‖ (m)"),
+    ("−9.1e-7", "bound_excess_max", "{:.1e}", "``bound_excess_max``, max"),
+    ("−2.8e-6", "position_only_bound_excess_max", "{:.1e}", "``bound_excess_max``, max"),
+    ("0.985", "velocity_error_max_m_per_s", "{:.3f}", "max ‖ṙ_e‖ (m/s)"),
+    ("4.147", "position_only_velocity_error_max_m_per_s", "{:.3f}", "max ‖ṙ_e‖ (m/s)"),
+    ("58.14", "free_velocity_error_max_m_per_s", "{:.2f}", "max ‖ṙ_e‖ (m/s)"),
+    ("−0.0150", "velocity_bound_excess_max", "{:.4f}", "``velocity_bound_excess_max`` (m/s)"),
+    ("0.00406", "control_accel_max", "{:.5f}", "``control_accel_max`` (m/s²)"),
+    ("0.567", "position_only_control_accel_max", "{:.3f}", "``control_accel_max`` (m/s²)"),
+    ("81.9", "control_effort_m_per_s", "{:.1f}", "control effort ∫‖u‖ dt (m/s)"),
+    ("408.8", "position_only_control_effort_m_per_s", "{:.1f}", "control effort ∫‖u‖ dt"),
+    ("49 478", "n_rhs", "{:,}", "RHS evaluations"),
+    ("100 446", "position_only_n_rhs", "{:,}", "RHS evaluations"),
+    ("19 634", "free_n_rhs", "{:,}", "RHS evaluations"),
+    (
+        "(closest approach 2.8e-6 m inside)",
+        "position_only_bound_excess_max*-1",
+        "(closest approach {:.1e} m inside)",
+    ),
+    (
+        "grows, to 4.15 m/s in ten orbits",
+        "position_only_velocity_error_max_m_per_s",
+        "grows, to {:.2f} m/s in ten orbits",
+    ),
+    (
+        "reaches 990 m at 0.33 orbit",
+        "fn:m_first_reach:position_only:990",
+        "reaches 990 m at {:.2f} orbit",
+    ),
+    (
+        "(per-orbit maxima 0.28,",
+        "fn:m_orbit_max:maintenance:velocity:1",
+        "(per-orbit maxima {:.2f},",
+    ),
+    (" 0.47,", "fn:m_orbit_max:maintenance:velocity:2", " {:.2f},", "per-orbit maxima"),
+    ("0.61,", "fn:m_orbit_max:maintenance:velocity:3", "{:.2f},", "per-orbit maxima"),
+    (" 0.71,", "fn:m_orbit_max:maintenance:velocity:4", " {:.2f},", "per-orbit maxima"),
+    (" 0.79,", "fn:m_orbit_max:maintenance:velocity:5", " {:.2f},", "per-orbit maxima"),
+    (" 0.88,", "fn:m_orbit_max:maintenance:velocity:6", " {:.2f},", "per-orbit maxima"),
+    (" 0.94,", "fn:m_orbit_max:maintenance:velocity:7", " {:.2f},", "per-orbit maxima"),
+    (" 0.98,", "fn:m_orbit_max:maintenance:velocity:8", " {:.2f},", "per-orbit maxima"),
+    (
+        " 0.985, 0.985 m/s)",
+        "fn:m_orbit_max:maintenance:velocity:9",
+        " {:.3f}, 0.985 m/s)",
+        "per-orbit maxima",
+    ),
+    ("0.985 m/s) and stays", "fn:m_orbit_max:maintenance:velocity:10", "{:.3f} m/s) and stays"),
+    (
+        "990 m only at 4.09 orbits",
+        "fn:m_first_reach:maintenance:990",
+        "990 m only at {:.2f} orbits",
+    ),
+    ("below 0.0041 m/s²", "control_accel_max", "below {:.4f} m/s²"),
+    (
+        "(about 140 times",
+        "fn:ratio:position_only_control_accel_max/control_accel_max",
+        "(about {:.0f} times",
+    ),
+    (
+        "effort is 5.0 times smaller",
+        "fn:ratio:position_only_control_effort_m_per_s/control_effort_m_per_s",
+        "effort is {:.1f} times smaller",
+    ),
+    ("exceeds 1e-3 N on 91.2 %", "fn:m_fraction:mu_velocity:1e-3:1", "exceeds 1e-3 N on {:.1f} %"),
+    ("1e-4 m/s² on 94 %", "fn:m_fraction:u:1e-4:0", "1e-4 m/s² on {:.0f} %"),
+    (
+        "error reaches 0.28 m/s in the first orbit",
+        "fn:m_orbit_max:maintenance:velocity:1",
+        "error reaches {:.2f} m/s in the first orbit",
+    ),
+    ("the free run's 5.73 m/s", "fn:m_orbit_max:free:velocity:1", "the free run's {:.2f} m/s"),
+    ("dual violation 0.118 N", "fn:m_kkt:maintenance:position:dual", "dual violation {:.3f} N"),
+    ("(μ < 0 on 22 %", "fn:m_fraction:mu_position_negative:0:0", "(μ < 0 on {:.0f} %"),
+    (
+        "2.97 N·m; velocity",
+        "fn:m_kkt:maintenance:position:mu_g",
+        "{:.2f} N·m; velocity",
+        "KKT conditions (maxima",
+    ),
+    ("velocity bound 0.282 N", "fn:m_kkt:maintenance:velocity:dual", "velocity bound {:.3f} N"),
+    ("and 0.355", "fn:m_kkt:maintenance:velocity:mu_g", "and {:.3f}", "velocity bound 0.282 N"),
+    ("position only 0.024 N", "fn:m_kkt:position_only:position:dual", "position only {:.3f} N"),
+    ("and 439 N·m", "fn:m_kkt:position_only:position:mu_g", "and {:.0f} N·m"),
+    ("function < 1e-14.", "fn:m_stationarity", "function < {:.0e}.", "", "below"),
+    ("6.84 km after one orbit", "fn:m_free_after_km:1", "{:.2f} km after one orbit"),
+    ("68.8 km after ten", "fn:m_free_after_km:10", "{:.1f} km after ten"),
+)
+_add(
+    CH6,
+    "maintenance-40",
+    ("−2.7e-6 m, ``velocity", "bound_excess_max", "{:.1e} m, ``velocity"),
+    (
+        "``velocity_error_max_m_per_s`` 5.14 m/s",
+        "velocity_error_max_m_per_s",
+        "``velocity_error_max_m_per_s`` {:.2f} m/s",
+    ),
+    ("``control_accel_max`` 0.861 m/s²", "control_accel_max", "``control_accel_max`` {:.3f} m/s²"),
+    ("3997 m/s, 602 106", "control_effort_m_per_s", "{:.0f} m/s, 602 106"),
+    ("602 106 RHS", "n_rhs", "{:,} RHS"),
+)
+_add(
+    CH6,
+    "maintenance-slack-120",
+    (
+        "(``velocity_bound_excess_max`` < 1e-10 m/s, round-off)",
+        "velocity_bound_excess_max",
+        "(``velocity_bound_excess_max`` < {:.0e} m/s, round-off)",
+        "",
+        "below",
+    ),
+    ("``bound_excess_max`` −7.7e-7 m", "bound_excess_max", "``bound_excess_max`` {:.1e} m"),
+    ("peaks at 0.121 m/s²", "control_accel_max", "peaks at {:.3f} m/s²"),
+    ("effort is 185.3 m/s", "control_effort_m_per_s", "effort is {:.1f} m/s"),
+    ("534 898 RHS", "n_rhs", "{:,} RHS"),
+)
+
+# docs/theory/chapter6.rst ---------------------------------------------------------------------
+_add(
+    TH6,
+    "maintenance",
+    ("to 4.15 m/s and", "position_only_velocity_error_max_m_per_s", "to {:.2f} m/s and"),
+    ("peaks at 0.567 m/s²", "position_only_control_accel_max", "peaks at {:.3f} m/s²"),
+    ("against 0.985 m/s", "velocity_error_max_m_per_s", "against {:.3f} m/s"),
+    ("and 0.0041 m/s² with it", "control_accel_max", "and {:.4f} m/s² with it"),
+)
+
+# docs/scenarios/smd_compare.rst ---------------------------------------------------------------
+_CMP_ROWS = {
+    "smd-gt": (
+        ("51143", "objective_uk", "{:.0f}"),
+        ("37394 / 37394", "objective_direct", "{:.0f} / 37394"),
+        ("37394 / 37394", "objective_direct_quadrature", "37394 / {:.0f}"),
+        ("1.37", "objective_ratio_uk_over_direct", "{:.2f}"),
+        ("753.5 / 746.8", "control_effort_uk", "{:.1f} / 746.8"),
+        ("753.5 / 746.8", "control_effort_direct", "753.5 / {:.1f}"),
+        ("1.04; 0.146", "x_max_abs_difference_m", "{:.2f}; 0.146"),
+        ("1.04; 0.146", "x_rms_difference_m", "1.04; {:.3f}"),
+        ("10.9", "v_max_abs_difference_m_s", "{:.1f}"),
+        ("14.9", "u_rms_difference_m_s2", "{:.1f}"),
+        ("5.0025 / 5.0000", "x_final_uk", "{:.4f} / 5.0000"),
+        ("5.0025 / 5.0000", "x_final_direct", "5.0025 / {:.4f}"),
+        ("25.35 / 0.017", "u_final_uk", "{:.2f} / 0.017"),
+        ("25.35 / 0.017", "u_final_direct", "25.35 / {:.3f}"),
+        ("0; 25.8", "uk_dual_violation_max", "{:.0f}; 25.8"),
+        ("0; 25.8", "uk_complementarity_abs_max", "0; {:.1f}"),
+        ("5.0e-8; 0", "direct_primal_violation_max", "{:.1e}; 0"),
+        ("5.0e-8; 0", "direct_dual_violation_max", "5.0e-8; {:.0f}"),
+        ("< 1e-13; 20", "direct_kkt_stationarity_relative", "< {:.0e}; 20", "below"),
+        ("< 1e-13; 20", "direct_iterations", "< 1e-13; {}"),
+        ("1.4 (GT)", "objective_ratio_uk_over_direct", "{:.1f} (GT)"),
+        ("(25.4,", "u_final_uk", "({:.1f},"),
+        ("(0.017,", "u_final_direct", "({:.3f},"),
+        ("(x(30 s) = 5.0025 m,", "x_final_uk", "(x(30 s) = {:.4f} m,"),
+    ),
+    "smd-lt": (
+        ("81.26", "objective_uk", "{:.2f}"),
+        ("3.283 / 3.283", "objective_direct", "{:.3f} / 3.283"),
+        ("3.283 / 3.283", "objective_direct_quadrature", "3.283 / {:.3f}"),
+        ("24.8", "objective_ratio_uk_over_direct", "{:.1f}"),
+        ("3.911 / 0.797", "control_effort_uk", "{:.3f} / 0.797"),
+        ("3.911 / 0.797", "control_effort_direct", "3.911 / {:.3f}"),
+        ("0.654; 0.107", "x_max_abs_difference_m", "{:.3f}; 0.107"),
+        ("0.654; 0.107", "x_rms_difference_m", "0.654; {:.3f}"),
+        ("1.83", "v_max_abs_difference_m_s", "{:.2f}"),
+        ("1.11", "u_rms_difference_m_s2", "{:.2f}"),
+        ("≈ 0 (< 1e-14) / −2.0e-10", "x_final_uk", "≈ 0 (< {:.0e}) / −2.0e-10", "below"),
+        ("≈ 0 (< 1e-14) / −2.0e-10", "x_final_direct", "≈ 0 (< 1e-14) / {:.1e}"),
+        ("≈ 0 (< 1e-13) / 1.1e-12", "u_final_uk", "≈ 0 (< {:.0e}) / 1.1e-12", "below"),
+        ("≈ 0 (< 1e-13) / 1.1e-12", "u_final_direct", "≈ 0 (< 1e-13) / {:.1e}"),
+        ("0.101; 1.64", "uk_dual_violation_max", "{:.3f}; 1.64"),
+        ("0.101; 1.64", "uk_complementarity_abs_max", "0.101; {:.2f}"),
+        ("9.9e-9; 0", "direct_primal_violation_max", "{:.1e}; 0"),
+        ("9.9e-9; 0", "direct_dual_violation_max", "9.9e-9; {:.0f}"),
+        ("< 1e-13; 8", "direct_kkt_stationarity_relative", "< {:.0e}; 8", "below"),
+        ("< 1e-13; 8", "direct_iterations", "< 1e-13; {}"),
+        ("25 (LT)", "objective_ratio_uk_over_direct", "{:.0f} (LT)"),
+        ("(0.80 m/s of effort)", "control_effort_direct", "({:.2f} m/s of effort)"),
+        ("contact (3.9 m/s)", "control_effort_uk", "contact ({:.1f} m/s)"),
+    ),
+    "smd-bi": (
+        ("4433", "objective_uk", "{:.0f}"),
+        ("1580.5 / 1580.4", "objective_direct", "{:.1f} / 1580.4"),
+        ("1580.5 / 1580.4", "objective_direct_quadrature", "1580.5 / {:.1f}"),
+        ("2.81", "objective_ratio_uk_over_direct", "{:.2f}"),
+        ("169.2 / 151.0", "control_effort_uk", "{:.1f} / 151.0"),
+        ("169.2 / 151.0", "control_effort_direct", "169.2 / {:.1f}"),
+        ("0.948; 0.165", "x_max_abs_difference_m", "{:.3f}; 0.165"),
+        ("0.948; 0.165", "x_rms_difference_m", "0.948; {:.3f}"),
+        ("4.99", "v_max_abs_difference_m_s", "{:.2f}"),
+        ("6.54", "u_rms_difference_m_s2", "{:.2f}"),
+        ("1.0067 / 1.0000", "x_final_uk", "{:.4f} / 1.0000"),
+        ("1.0067 / 1.0000", "x_final_direct", "1.0067 / {:.4f}"),
+        ("4.77 / 0.0033", "u_final_uk", "{:.2f} / 0.0033"),
+        ("4.77 / 0.0033", "u_final_direct", "4.77 / {:.4f}"),
+        ("15.9; 33.4", "uk_dual_violation_max", "{:.1f}; 33.4"),
+        ("15.9; 33.4", "uk_complementarity_abs_max", "15.9; {:.1f}"),
+        ("2.0e-8; 0", "direct_primal_violation_max", "{:.1e}; 0"),
+        ("2.0e-8; 0", "direct_dual_violation_max", "2.0e-8; {:.0f}"),
+        ("< 1e-13; 24", "direct_kkt_stationarity_relative", "< {:.0e}; 24", "below"),
+        ("< 1e-13; 24", "direct_iterations", "< 1e-13; {}"),
+        ("2.8 (BI)", "objective_ratio_uk_over_direct", "{:.1f} (BI)"),
+        ("up to 15.9 N in", "uk_dual_violation_max", "up to {:.1f} N in"),
+        ("up to 33 N·m", "uk_complementarity_abs_max", "up to {:.0f} N·m"),
+        ("1.0067 m, against", "x_final_uk", "{:.4f} m, against"),
+        ("0.0033 m/s²)", "u_final_direct", "{:.4f} m/s²)"),
+        ("4.8 m/s²)", "u_final_uk", "{:.1f} m/s²)"),
+    ),
+}
+for _case, _rows in _CMP_ROWS.items():
+    _add(CMP, "smd-compare", *((t, f"{_case}/{k}", f, "", *x) for t, k, f, *x in _rows))
+_add(
+    CMP,
+    "smd-compare-thesis-nodes",
+    ("gives 1613.99 N²·s/kg", "objective_direct_quadrature", "gives {:.2f} N²·s/kg"),
+    ("2.0 % above", "above_converged_percent", "{:.1f} % above"),
+    ("optimum (1581.697,", "converged_objective", "optimum ({:.3f},"),
+    ("−6.7 m to", "x_direct_collocation_min_m", "{:.1f} m to"),
+    ("to 8.6 m (``x_direct", "x_direct_collocation_max_m", "to {:.1f} m (``x_direct"),
+    ("between 0.934 m", "x_direct_min_on_grid_m", "between {:.3f} m"),
+    ("and 1.5 m (``x_direct", "x_direct_max_on_grid_m", "and {:.1f} m (``x_direct"),
+)
+
+# docs/optimize.rst (benchmarks/bench_optimize.py --table; its times are in TIMINGS) ----------
+_UNIFORM = {
+    10: ("1632.194808", "12"),
+    20: ("1565.181084", "21"),
+    40: ("1598.171984", "20"),
+    80: ("1572.772048", "21"),
+    150: ("1580.395221", "24"),
+    300: ("1581.203163", "24"),
+    600: ("1581.684006", "29"),
+}
+for _n, (_objective, _iterations) in _UNIFORM.items():
+    _add(
+        OPT,
+        "optimize-table",
+        (f"- {_objective}", f"uniform_{_n}/objective", "- {:.6f}", f"   * - {_n}"),
+        (f"- {_iterations}", f"uniform_{_n}/iterations", "- {}", f"   * - {_n}"),
+    )
+_ADAPTIVE = [
+    (10, "1632.194808", "7.7e-1"),
+    (40, "1598.171984", "1.4e-2"),
+    (115, "1579.861075", "2.9e-4"),
+    (142, "1581.555901", "1.2e-5"),
+    (148, "1581.685215", "1.5e-6"),
+    (150, "1581.685556", "6.7e-7"),
+]
+for _i, (_elements, _objective, _error) in enumerate(_ADAPTIVE):
+    _near = f"   * - {_i}"
+    _add(
+        OPT,
+        "optimize-table",
+        (f"- {_elements}", f"adaptive_{_i}/elements", "- {}", _near),
+        (f"- {_objective}", f"adaptive_{_i}/objective", "- {:.6f}", _near),
+        (f"- {_error}", f"adaptive_{_i}/max_error", "- {:.1e}", _near),
+    )
+_add(
+    OPT,
+    "optimize-table",
+    ("# 1580.395… N²·s/kg", "uniform_150/objective", "# {:.3f}… N²·s/kg"),
+    ("at the 451 nodes", "uniform_150/nodes", "at the {} nodes"),
+    ("end at 1581.697332 (280", "adaptive_1e-08/objective", "end at {:.6f} (280"),
+    ("(280 elements, largest", "adaptive_1e-08/elements", "({} elements, largest"),
+    ("error estimate 1.4e-8)", "adaptive_1e-08/max_error", "error estimate {:.1e})"),
+    ("at 1581.697220 (505", "adaptive_1e-09/objective", "at {:.6f} (505"),
+    ("(505 elements, 8.3e-9)", "adaptive_1e-09/elements", "({} elements, 8.3e-9)"),
+    ("elements, 8.3e-9)", "adaptive_1e-09/max_error", "elements, {:.1e})"),
+    ("agree to 7e-8 relative", "adaptive_1e-08/agreement", "agree to {:.0e} relative"),
+    ("is 1581.697 to the digits", "adaptive_1e-08/objective", "is {:.3f} to the digits"),
+    ("(1581.673 at 1200 elements)", "uniform_1200/objective", "({:.3f} at 1200 elements)"),
+    ("reaches 7e-6 relative", "adaptive_150/relative_error", "reaches {:.0e} relative"),
+    ("mesh is 8e-4 off", "uniform_150/relative_error", "mesh is {:.0e} off"),
+)
+_add(
+    CH4,
+    "fccn",
+    (
+        "2e-10 N, is what remains",
+        "nominal_translational_constraint_force_max_N",
+        "{:.0e} N, is what remains",
+    ),
+)
+
+_add(
+    TH6,
+    "smd-gt",
+    (
+        "within 2.9e-11 m of the bound",
+        "fn:diff:x_min-steady_state_x_m",
+        "within {:.1e} m of the bound",
+    ),
+    ("within 2.9e-11 m of x = 5 m", "fn:diff:x_min-steady_state_x_m", "within {:.1e} m of x = 5 m"),
+    (
+        "2.5e-3 m at 30 s on SMD-GT",
+        "fn:diff:x_final-steady_state_x_m",
+        "{:.1e} m at 30 s on SMD-GT",
+    ),
+)
+_add(
+    TH6,
+    "smd-gt-damped",
+    (
+        "(abs(x − 5) < 1e-13 m at 30 s",
+        "x_final",
+        "(abs(x − 5) < {:.0e} m at 30 s",
+        "",
+        "below",
+        5.0,
+    ),
+)
+
+# not results: the thesis's inputs, gmuk's chosen settings, thresholds, and quantities computed
+# from those alone ------------------------------------------------------------------------------
+_INPUT = "an input of the scenario (the thesis's or gmuk's chosen setting)"
+_FROM_INPUTS = "computed from the inputs alone, not by a run"
+_THRESHOLD = "a threshold of the sentence, not a result"
+ALLOWED += [
+    (CH4, "ω_n = 1e-3 s⁻¹", _INPUT),
+    (CH4, "at rtol 3e-15", _INPUT),
+    (CH4, "ω_n = 1e-3, 15 010 at 3e-3, 75 008 at 1e-2", "the gains of the runs compared"),
+    (CH4, "α_r = 2e-3 s⁻¹", _INPUT),
+    (CH4, "Figures below 1e-13", _THRESHOLD),
+    (CH4, "about 2.2e3 N of gravity", _FROM_INPUTS + " (m μ / a², FCCN)"),
+    (CH4, "round-off is 1e-16", "the double-precision unit round-off"),
+    (CH4, "two poses 4e6 m from", _FROM_INPUTS + " (the orbit's radius)"),
+    (CH4, "gravity forces of 3.4e3 N", _FROM_INPUTS + " (m μ / r_p²)"),
+    (CH4, "mass is 7063 kg", _INPUT),
+    (CH6, "x ≥ 5 m", _INPUT),
+    (CH6, "x ≤ 1 m", _INPUT),
+    (CH6, "1 m ≤ x ≤ 2 m", _INPUT),
+    (CH6, "about the 25 m/s²", _FROM_INPUTS + " (the analytic steady state k·5/m)"),
+    (CH6, "its 0.125 m skin", _FROM_INPUTS + " (m_w / (4 m))"),
+    (CH6, "t = 0, 3 m above it", _INPUT + " (x₀ − 5)"),
+    (CH6, "1.157 m; the bound", _FROM_INPUTS + " (the free motion's maximum)"),
+    (CH6, "< 1e-3 m/s²", _THRESHOLD),
+    (CH6, "within 1 mm of 2 m", _THRESHOLD),
+    (CH6, "falls to 1 m", _INPUT),
+    (CH6, "bounces on 1 m", _INPUT),
+    (CH6, "settles on 1 m (within 1 mm", _THRESHOLD),
+    (CH6, "injection error of 1 m", _INPUT),
+    (CH6, "a 10 m contact", _FROM_INPUTS + " (m_w / (4 m))"),
+    (CH6, "α = 2e-3 s⁻¹, β = 1e-6 s⁻²", _INPUT),
+    (CH6, "α = 2e-3 s⁻¹ (velocity)", _INPUT),
+    (CH6, "rtol = atol = 1e-10", _INPUT),
+    (CH6, "γ = 1 m/s", _INPUT),
+    (CH6, "= 10 m/s, larger", _FROM_INPUTS + " (m_w / (4 m))"),
+    (CH6, "margin near 1 m/s", _INPUT + " (γ)"),
+    (CH6, "(skins 0.1 m and 0.1 m/s;", _FROM_INPUTS + " (m_w / (4 m))"),
+    (CH6, "4 m Δ", "a formula"),
+    (CH6, "(100 km, circular, 11°), the bound δ = 1000 m", _INPUT),
+    (CMP, "--refine-tol 1e-6", _INPUT),
+    (CMP, "GT (x ≥ 5 m)", _INPUT),
+    (CMP, "LT (x ≤ 1 m)", _INPUT),
+    (CMP, "BI (1 m ≤ x ≤ 2 m)", _INPUT),
+    (CMP, "Figures below 1e-13", _THRESHOLD),
+    (CMP, "bound x ≤ 1 m", _INPUT),
+    (CMP, "contact at 2 m", _INPUT),
+    (TH6, ":math:`m` = 2 kg", _INPUT),
+    (TH6, "0.125 m; for the maintenance", _FROM_INPUTS + " (m_w / (4 m))"),
+    (TH6, ":math:`m` = 300 kg", _INPUT),
+    (TH6, "= 10 m for the position bound", _FROM_INPUTS),
+    (TH6, "same number, 10 m/s", _FROM_INPUTS),
+    (TH6, "γ = 1 m/s", _INPUT),
+]
+
+_add(
+    CH4,
+    "fcei-unstabilised",
+    (":math:`e^{6.3}` per orbit", "growth_exponent_per_orbit", ":math:`e^{{{:.1f}}}` per orbit"),
+    ("per orbit of 22 696 s", "period_s", "per orbit of {:,.0f} s"),
+    ("5.9e-14 rad after one orbit", "attitude_error_1_orbit_rad", "{:.1e} rad after one orbit"),
+    ("1.9e-8 rad after three", "attitude_error_3_orbits_rad", "{:.1e} rad after three"),
+    ("2.4 rad after six", "attitude_error_6_orbits_rad", "{:.1f} rad after six"),
+    ("damps errors 3.6 times", "omega_n_over_growth_rate", "damps errors {:.1f} times"),
+)
+_add(
+    CH4,
+    "fcei-reference",
+    ("stays 2.4–", "omega_n_over_max", "stays {:.1f}–"),
+    ("–5.3 times above", "omega_n_over_min", "–{:.1f} times above"),
+    ("(1.9e-4 to", "turn_rate_min", "({:.1e} to"),
+    ("to 4.2e-4 rad/s)", "turn_rate_max", "to {:.1e} rad/s)"),
+)
+UNREGENERATED += [
+    (
+        CH4,
+        "1635 steps",
+        "12 orbits of FCEI without Baumgarte terms, 2026-11-26: not wired as a run",
+    ),
+    (
+        CH4,
+        "15 010 at 3e-3, 75 008 at 1e-2",
+        "12 orbits of FCEI at stiffer gains, 2026-11-26: not wired as runs (minutes each)",
+    ),
+    (
+        CH4,
+        "drifted (exit 3) at",
+        "the 'before' column of the T²SE(3) table is the code before the stabilisation",
+    ),
+]
+
+UNREGENERATED += [
+    (CH4, "t = 87 553 s (3.9 orbits)", "history: the T²SE(3) 'before' column"),
+    (CH4, "3.14 rad / 4.9e-6 m", "history: the T²SE(3) 'before' column"),
+    (CH4, "4.9e-6 m                   3.4e-7 m", "history: the T²SE(3) 'before' column"),
+    (CH4, "2020 / 32 306 / 31 s", "history: the T²SE(3) 'before' column"),
+    (CH4, "t = 90 009 s (4.0 orbits)", "history: the T²SE(3) 'before' column"),
+    (CH4, "3.15 rad", "history: the T²SE(3) 'before' column"),
+    (CH4, "1.3e-5 m", "history: the T²SE(3) 'before' column"),
+    (CH4, "7.2e-13 rad", "history: the T²SE(3) 'before' column"),
+    (CH4, "33 662 / 59 s", "history: the T²SE(3) 'before' column"),
+]
+
+_MACHINE = "2-core Xeon shared with other jobs"
+TIMINGS += [
+    (CH4, "5438 / 1.8 s", f"wall_time_s, 2026-11-26, {_MACHINE}"),
+    (CH4, "4153 steps (6.6 s on 2026-11-26", f"wall_time_s, {_MACHINE}"),
+    (CH4, "3921 / 65 414 / 80 s", f"wall_time_s, 2026-11-26, {_MACHINE}"),
+    (CH4, "65 726 / 169 s", f"wall_time_s, 2026-11-26, {_MACHINE}"),
+    (CH6, "Wall time 22.6 s for the three runs", f"wall_time_s, 2026-11-25, {_MACHINE}"),
+    (CH6, "the same numbers as above) 17.6 s", f"wall_time_s, 2026-11-25, {_MACHINE}"),
+    (CH6, "85 s on 2026-11-26", f"wall_time_s, {_MACHINE}"),
+    (CH6, "(84.3 s", f"wall_time_s, 2026-11-25, {_MACHINE}"),
+    (CMP, "``wall_time_s`` 5.5 s", f"2026-11-25, {_MACHINE}"),
+    (OPT, "- 0.431", "benchmarks/bench_optimize.py, 2026-11-25, load 3.7 on 2 cores"),
+    (OPT, "- 0.606", "benchmarks/bench_optimize.py, 2026-11-25, load 3.7 on 2 cores"),
+    (OPT, "0.71 times the hand-written", "a ratio of the two timings above"),
+]
