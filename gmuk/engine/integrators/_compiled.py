@@ -151,7 +151,14 @@ def _call_back(typingctx, address, phase):  # type: ignore[no-untyped-def]
     return types.int64(types.int64, types.int64), codegen
 
 
-@njit(cache=True)
+#: The decorator of the loop's helpers, which only compiled code calls (rhs, advance and
+#: each other): without the CPython and C wrappers that a call from Python or C would need,
+#: which numba otherwise lowers, optimises and compiles to machine code for every function
+#: (issue #24, the cold compile). Such a helper cannot be called from Python.
+_helper = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+
+
+@_helper
 def _write_state(t, g, V, Y, d, io):  # type: ignore[no-untyped-def]
     """The stage's state into ``io`` for the Python callback (PythonParts.state)."""
     nr = d.n_rigid
@@ -166,7 +173,7 @@ def _write_state(t, g, V, Y, d, io):  # type: ignore[no-untyped-def]
         io[1 + 22 * nr + i] = Y[12 * nr + i]
 
 
-@njit(cache=True)
+@_helper
 def _python_accelerations(parts, aux):  # type: ignore[no-untyped-def]
     """The whole acceleration from Python (PHASE_ACCELERATIONS) into ``aux``; the state is
     in ``io`` already. Returns the status."""
@@ -401,7 +408,7 @@ def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-un
     return DONE
 
 
-@njit(cache=True)
+@_helper
 def _apply_M(a, J, m_r, m_e, r_off, e_off, out):  # type: ignore[no-untyped-def]
     """out = M a for the block-diagonal mass matrix: [J ω̇; m v̇] per rigid body, m ẍ per
     point-mass coordinate (System._apply_M)."""
@@ -414,7 +421,7 @@ def _apply_M(a, J, m_r, m_e, r_off, e_off, out):  # type: ignore[no-untyped-def]
         out[e_off[i]] = m_e[i] * a[e_off[i]]
 
 
-@njit(cache=True)
+@_helper
 def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[no-untyped-def]
     """The stacked rows (A, b) of the constraints, as their ``rows`` give them: computed by
     their kernels (through the addresses in ``cons``; a rigid body's columns start at its offset in
@@ -452,7 +459,7 @@ def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[n
     return 0
 
 
-@njit(cache=True)
+@_helper
 def _scale(Y0, Y1, G0, nr, pts, rtol, atol, sc):  # type: ignore[no-untyped-def]
     """The error weights of :meth:`gmuk.engine.integrate._Problem.scale` (``pts``: where the point
     masses' 3-vectors start in Y; other Euclidean entries are scalars)."""
@@ -477,7 +484,7 @@ def _scale(Y0, Y1, G0, nr, pts, rtol, atol, sc):  # type: ignore[no-untyped-def]
         sc[o] = sc[o + 1] = sc[o + 2] = w
 
 
-@njit(cache=True)
+@_helper
 def _rms(v, sc):  # type: ignore[no-untyped-def]
     acc = 0.0
     for i in range(v.shape[0]):
@@ -485,7 +492,7 @@ def _rms(v, sc):  # type: ignore[no-untyped-def]
     return math.sqrt(acc / v.shape[0])
 
 
-@njit(cache=True)
+@_helper
 def _interpolate(F, Y0, s, out):  # type: ignore[no-untyped-def]
     """DOP853's continuous extension u(s) into ``out`` (gmuk.engine.integrators.dop853)."""
     n = Y0.shape[0]
@@ -499,7 +506,7 @@ def _interpolate(F, Y0, s, out):  # type: ignore[no-untyped-def]
         out[j] = Y0[j] + acc[j]
 
 
-@njit(cache=True)
+@_helper
 def _stage_state(Y, h, a, K, i, out):  # type: ignore[no-untyped-def]
     """out = Y + h Σ_{m<i} a_m K_m: the state at which stage i is evaluated."""
     for j in range(Y.shape[0]):
@@ -509,7 +516,7 @@ def _stage_state(Y, h, a, K, i, out):  # type: ignore[no-untyped-def]
         out[j] = Y[j] + h * q
 
 
-@njit(cache=True)
+@_helper
 def _factor(err, m):  # type: ignore[no-untyped-def]
     """The step-size factor for a scaled error estimate (1: at tolerance): the classical
     ``safety · err^(−1/order)``, err floored so that a zero estimate grows the step by the
@@ -517,26 +524,26 @@ def _factor(err, m):  # type: ignore[no-untyped-def]
     return m.safety * (max(err, m.error_floor) ** (-1.0 / m.order))
 
 
-@njit(cache=True)
+@_helper
 def _grown(h, err, m):  # type: ignore[no-untyped-def]
     """The next step after an accepted one of size h."""
     return h * min(m.max_factor, max(m.min_factor, _factor(err, m)))
 
 
-@njit(cache=True)
+@_helper
 def _shrunk(h, err, m):  # type: ignore[no-untyped-def]
     """The retry after a rejected step of size h."""
     return h * max(m.min_factor, min(m.max_factor_rejected, _factor(err, m)))
 
 
-@njit(cache=True)
+@_helper
 def _fail(status, t, fs, ints):  # type: ignore[no-untyped-def]
     """Record a failed evaluation at time t; returns the status to report."""
     fs[F_BAD_T] = t
     return status
 
 
-@njit(cache=True)
+@_helper
 def _initial_step(t, Y, G0, f0, parts, m, fs, ints):  # type: ignore[no-untyped-def]
     """Hairer's starting step (Hairer, Nørsett & Wanner, Solving ODEs I, §II.4), or the
     user's first step. Returns the step, or −(status) after a failed evaluation."""
@@ -572,13 +579,13 @@ def _initial_step(t, Y, G0, f0, parts, m, fs, ints):  # type: ignore[no-untyped-
     return min(100 * h0, h1, fs[F_MAX_STEP], t_end - t)
 
 
-@njit(cache=True)
+@_helper
 def aux_size_of(d):  # type: ignore[no-untyped-def]
     """:func:`aux_size` of a program's dims."""
     return 5 * d.n_dof + d.n_rows + 2 + d.n_control
 
 
-@njit(cache=True)
+@_helper
 def _record(t, Y, G0, aux, ints, bt, bY, bG, baux):  # type: ignore[no-untyped-def]
     """Append one output row (t, Y, G0, aux) to the buffers."""
     w = ints[I_WRITTEN]
@@ -594,7 +601,7 @@ def _record(t, Y, G0, aux, ints, bt, bY, bG, baux):  # type: ignore[no-untyped-d
     ints[I_WRITTEN] = w + 1
 
 
-@njit(cache=True)
+@_helper
 def _start(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux):  # type: ignore[no-untyped-def]
     """The first evaluation at the start time: f0 and aux, the output at the start time of
     a fresh run, and the starting step when none is set. Returns the status."""
@@ -617,7 +624,7 @@ def _start(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux)
     return DONE
 
 
-@njit(cache=True)
+@_helper
 def _step_error(K, Y, Y1, G0, h, parts, m, fs, sc):  # type: ignore[no-untyped-def]
     """The scaled error of a step (≤ 1: within tolerance), its weights into ``sc``."""
     n = Y.shape[0]
@@ -645,7 +652,7 @@ def _step_error(K, Y, Y1, G0, h, parts, m, fs, sc):  # type: ignore[no-untyped-d
     return math.sqrt(acc2 / n)
 
 
-@njit(cache=True)
+@_helper
 def _extension(t, h, Y, Y1, K, G0, parts, m, fs, ints, F):  # type: ignore[no-untyped-def]
     """DOP853's continuous extension on [t, t + h] into F (three more stages). Returns the
     status."""
@@ -681,7 +688,7 @@ def _extension(t, h, Y, Y1, K, G0, parts, m, fs, ints, F):  # type: ignore[no-un
     return DONE
 
 
-@njit(cache=True)
+@_helper
 def _extension_error(t, h, Y, F, G0, parts, m, fs, ints, sc):  # type: ignore[no-untyped-def]
     """The continuous extension's error from its defect at s* (DOP853.interpolant_error):
     returns (scaled error, status)."""
@@ -711,7 +718,7 @@ def _extension_error(t, h, Y, F, G0, parts, m, fs, ints, sc):  # type: ignore[no
     return m.defect_gain * math.sqrt(acc2 / n), DONE
 
 
-@njit(cache=True)
+@_helper
 def _new_base(Y1, G0, nr):  # type: ignore[no-untyped-def]
     """G₀ ← G₀ exp(ξ₁), re-orthonormalised by one Newton–Schulz step R ← R(3I − RᵀR)/2, and
     ξ₁ ← 0 (in place)."""
@@ -746,7 +753,7 @@ def _new_base(Y1, G0, nr):  # type: ignore[no-untyped-def]
                 G0[k, a, e] = G1[k, a, e]
 
 
-@njit(cache=True)
+@_helper
 def _first_stage(Y, aux, parts, f0):  # type: ignore[no-untyped-def]
     """The next step's first stage at the new base: ξ̇ = V at ξ = 0, and the accelerations
     of the step end's evaluation (aux)."""
