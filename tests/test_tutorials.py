@@ -19,10 +19,10 @@ CHECKS = {
     # automatic rows agree with the analytic ones to finite-difference accuracy, and the two
     # simulations agree; the pin holds
     "t1_holonomic_constraint.py": lambda r: (
-        r["rows_A_relative_difference"] < 1e-8
-        and r["rows_b_relative_difference"] < 1e-7
+        r["rows_A_relative_difference"] < 1e-13  # exact rows (jets): round-off only
+        and r["rows_b_relative_difference"] < 1e-13
         and r["pin_drift_m"] < 1e-9
-        and r["runs_position_difference_m"] < 1e-6
+        and r["runs_position_difference_m"] < 1e-10
     ),
     # the installed plugin is found by the registry and by `gmuk plugins`, and its drag is
     # the exponential decay it should be

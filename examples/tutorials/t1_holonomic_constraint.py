@@ -3,8 +3,9 @@
 A rigid body hangs from a point p_B of its own that is pinned at N's origin (a rigid-body
 spherical pendulum under gravity). The constraint is φ(q) = R_NB p_B + r_N = 0 (3 rows).
 
-Step 1 writes only the residual φ: gmuk derives A and b of A ν̇ = b by differentiating φ
-along the group. Step 2 overrides ``jacobian`` and ``bias`` with the exact forms:
+Step 1 writes only the residual φ: gmuk derives A and b of A ν̇ = b exactly, by
+differentiating φ along the group on derivative jets. Step 2 overrides ``jacobian`` and
+``bias`` with the forms derived by hand:
 with ν = [ω; v] in the body frame, φ̇ = R_NB(ω × p_B + v), so
 
     A = R_NB [−[p_B]×, I₃],    b = −R_NB (ω × (ω × p_B + v)).
@@ -38,7 +39,7 @@ class Pinned(gmuk.HolonomicConstraint):
 
 
 class PinnedAnalytic(Pinned):
-    """The same constraint with exact rows: no finite differences."""
+    """The same constraint with its rows derived by hand."""
 
     def jacobian(self, q, t):
         (g,) = q
