@@ -1936,3 +1936,60 @@ _add(
     ("against 452–", _R + "correct:max_cross_track_difference_m:min", "against {:.0f}–"),
     ("–664 m with the", _R + "correct:max_cross_track_difference_m:max", "–{:.0f} m with the"),
 )
+
+# docs/reliability.rst (not scanned by the guard; registered where it quotes the runs above) ----
+REL = "docs/reliability.rst"
+_add(
+    REL,
+    "fcei-unstabilised",
+    (
+        "from 5.9e-14 rad after one orbit",
+        "attitude_error_1_orbit_rad",
+        "from {:.1e} rad after one orbit",
+    ),
+    ("to 2.4 rad after six", "attitude_error_6_orbits_rad", "to {:.1f} rad after six"),
+)
+_add(
+    REL,
+    "fcei-12",
+    (
+        "attitude error < 1e-13 rad (round-off)",
+        "max_attitude_error_rad",
+        "attitude error < {:.0e} rad (round-off)",
+        "",
+        "below",
+    ),
+    (
+        "position error 2.7e-7 m",
+        "max_position_error_m",
+        "position error {:.1e} m",
+        "gmuk run fcei --orbits 12",
+    ),
+)
+_add(
+    REL,
+    "fceim-12",
+    (
+        "< 1e-13 rad and 2.8e-7 m",
+        "max_attitude_error_rad",
+        "< {:.0e} rad and 2.8e-7 m",
+        "",
+        "below",
+    ),
+    ("rad and 2.8e-7 m", "max_position_error_m", "rad and {:.1e} m"),
+)
+_add(
+    "docs/errata.rst",
+    "integral-gain-1000",
+    ("oscillates at 31.62 rad/s", "frequency_rad_s", "oscillates at {:.2f} rad/s"),
+    ("same amplitude (130.4) after 20 s", "amplitude_last_s", "same amplitude ({:.1f}) after 20 s"),
+)
+_add(
+    "docs/campaigns.rst",
+    "apollo16",
+    (
+        "(7239.3 m at degree 150",
+        "correct_deg150_max_position_difference_m",
+        "({:.1f} m at degree 150",
+    ),
+)
