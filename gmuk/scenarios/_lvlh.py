@@ -170,9 +170,10 @@ def nominal_constraint_wrench(orbit: KeplerOrbit, t: FloatArray) -> FloatArray:
     evaluated *on* the reference states: what the constraint must supply on the constraint
     manifold, free of integration error.
 
-    Its translational part is only the finite-size term of Eq. 23b (~5e-10 N here), below the
-    noise floor of the Eq. 67 rows off the reference (an attitude error of 3e-13 rad times the
-    0.7 m/s² centripetal term gives ~1e-9 N), so the simulated force cannot resolve it.
+    Its translational part is only the finite-size term of Eq. 23b (~5e-10 N on FCEI), the
+    remainder of gravity terms of ~3e3 N that cancel, so its relative shape is resolved only to
+    round-off (the summary's ``max_constraint_force_deviation_from_nominal_N`` gives how far
+    the simulated force is from it: ~1e-10 N on FCEI).
     """
     sc = spacecraft()
     ref = LVLHReference(orbit)

@@ -9,8 +9,9 @@ m, b, k, initial state and 30 s) two answers of the same System:
 * **direct optimum** — :class:`gmuk.optimize.OptimalControlProblem` on the same System: the
   control force u minimising ``∫ u²/m dt`` subject to the dynamics and the bounds on x at every
   node (path constraints, not the slack form), final state free; Lobatto IIIA collocation on
-  ``--elements`` elements of degree ``--degree`` (the thesis: one element of 5 points,
-  ``--elements 1 --degree 4``), or adaptively refined to ``--refine-tol``.
+  ``--elements`` elements of degree ``--degree`` (``--elements 1 --degree 4``: gmuk's scheme
+  on the thesis's five nodes, not the thesis's Eqs. 98–100; docs/scenarios/smd_compare.rst),
+  or adaptively refined to ``--refine-tol``.
 
 Both are compared on the UK run's output grid (every 0.01 s; the optimum interpolated in its
 elements): position, velocity, control acceleration u/m, control effort ``∫|u|/m dt``, the
