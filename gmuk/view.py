@@ -23,7 +23,7 @@ each path is drawn through at most ``max_path_points`` samples (default 2000) an
 animation has at most ``max_frames`` frames (default 150), both taken evenly spaced in the
 output index (the outputs of a gmuk run are evenly spaced in time), always keeping the first
 and last outputs. A self-contained view of one body is then about 5.1 MB whatever the run's
-length (a one-orbit FCEI run, 721 outputs: 5.06 MB), of which 4.8 MB is plotly.js; a view
+length (a one-orbit FCEI run, 721 outputs: 5.10 MB), of which 4.8 MB is plotly.js; a view
 that loads a shared copy of it (``write_view(..., library=FOLDER)``, as ``gmuk run`` writes
 them) is about 0.3 MB.
 """

@@ -303,7 +303,37 @@ def _fcei_gains() -> dict[str, Any]:
     return out
 
 
+def _view_sizes() -> dict[str, Any]:
+    """The 3-D view of a one-orbit FCEI run (MB): self-contained (``gmuk view``) and loading
+    a shared plotly.js (``gmuk run``'s view.html), as docs/view.rst quotes them."""
+    import tempfile
+
+    from gmuk import scenarios
+    from gmuk.view import view_html, write_view
+
+    scenario = scenarios.get("fcei")
+    result = scenario.run()
+    traj = result.trajectories[result.primary]
+    radius = scenario.central_radius
+    with tempfile.TemporaryDirectory() as folder:
+        alone = write_view(traj, Path(folder) / "alone.html", central_radius=radius)
+        shared = write_view(
+            traj, Path(folder) / "run" / "view.html", central_radius=radius, library=folder
+        )
+        sizes = {
+            "self_contained_MB": alone.stat().st_size / 1e6,
+            "shared_MB": shared.stat().st_size / 1e6,
+        }
+    from test_view import MOON_RADIUS, orbit_trajectory  # the synthetic orbits of its test
+
+    for key, n, orbits in (("short_MB", 200, 1.0), ("long_MB", 100_000, 10.0)):
+        page = view_html(orbit_trajectory(n=n, orbits=orbits), central_radius=MOON_RADIUS)
+        sizes[key] = len(page.encode()) / 1e6
+    return sizes
+
+
 RUNS: dict[str, Run] = {
+    "view-sizes": Run("(the FCEI 3-D views)", seconds=3, function=_view_sizes),
     "fcei": Run("fcei", seconds=3),
     "apollo16": Run("apollo16", seconds=8),
     "apollo16-rtol": Run("(apollo16 at rtol 1e-11 and 1e-13)", seconds=12, function=_apollo16_rtol),
@@ -694,6 +724,16 @@ def _add(doc: str, run: str, *rows: tuple[Any, ...]) -> None:
         offset = next((float(x) for x in rest[1:] if isinstance(x, (int, float))), None)
         FIGURES.append(Figure(doc, text, run, key, fmt, near, kind, offset))
 
+
+# docs/view.rst ---------------------------------------------------------------------------------
+_add(
+    "docs/view.rst",
+    "view-sizes",
+    ("5.10 MB self-contained", "self_contained_MB", "{:.2f} MB self-contained"),
+    ("0.28 MB ``view.html``", "shared_MB", "{:.2f} MB ``view.html``"),
+    ("gives 5.17 MB", "long_MB", "gives {:.2f} MB"),
+    ("against 5.07 MB", "short_MB", "against {:.2f} MB"),
+)
 
 # docs/scenarios/chapter4.rst ------------------------------------------------------------------
 _add(

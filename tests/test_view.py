@@ -137,7 +137,7 @@ def test_long_runs_are_decimated_so_the_file_stays_small():
     short = view_html(orbit_trajectory(n=200), central_radius=MOON_RADIUS)
     long = view_html(orbit_trajectory(n=100_000, orbits=10.0), central_radius=MOON_RADIUS)
     # 500 times the outputs cost less than 10 % more bytes: paths ≤ 2000 points, ≤ 150 frames
-    # (measured: 5.11 MB against 5.05 MB)
+    # (docs/view.rst gives the sizes; tests/docs_figures.py regenerates them)
     assert len(long) < 1.1 * len(short), (len(long), len(short))
     assert len(long) < 6_000_000
     idx = decimate(100_000, 150)
