@@ -195,6 +195,8 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
     :class:`Status`: DONE, NONFINITE, CALLBACK, or FIELD with the failed kernel's status in
     ``ints[I_FIELD]``."""
     d = parts.dims
+    terms, params, fdata = parts.terms, parts.params, parts.field_data
+    J, Jinv, m_r, m_e = parts.J, parts.Jinv, parts.m_rigid, parts.m_euclid
     r_off, e_off, io = parts.rigid_offsets, parts.euclid_offsets, parts.io
     nr, ne, ndof, s, nc = d.n_rigid, d.n_euclid, d.n_dof, d.n_rows, d.n_control
     total = aux[:ndof]
@@ -211,13 +213,168 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
         _compose_exp_into(G0, xi, g)
     x0 = 12 * nr
     z_dot = aux[5 * ndof + s + 1 : 5 * ndof + s + 1 + nc]
-    if d.solve == PYTHON_SOLVE:
+    # the whole acceleration in Python (PHASE_ACCELERATIONS): a program without a compiled
+    # solve, or a state whose rows the compiled QR solve cannot certify
+    in_python = d.solve == PYTHON_SOLVE
+    if in_python:
         _write_state(t, g, V, Y, d, io)
-        status = _python_accelerations(parts, aux)
-        if status != DONE:
-            return status
     else:
-        status = _compiled_accelerations(t, Y, g, V, parts, aux, ints)
+        # compiled force terms, then the parts in Python, the solve, the controllers and
+        # the loads on the plant (in this function, not a helper inlined into it: numba's
+        # inlining copies and retypes the helper's IR at each compilation)
+        unmodeled = aux[ndof : 2 * ndof]
+        modeled = np.zeros(ndof)
+        for i in range(ndof):
+            unmodeled[i] = 0.0
+        w = np.empty(6)
+        if d.point_terms:  # a point mass's pose and velocity, as its force kernels take them
+            gp = np.zeros((4, 4))
+            vp = np.zeros(6)
+            no_inertia = np.zeros((3, 3))
+        else:
+            gp = np.empty((0, 0))
+            vp = np.empty(0)
+            no_inertia = gp
+        for f in range(terms.shape[0]):
+            kernel, rig, idx, off = terms[f, 0], terms[f, 1], terms[f, 2], terms[f, 3]
+            p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]
+            if rig:
+                args = (True, t, g[idx], V[idx], m_r[idx], J[idx], params[p0:], fdata[f0:f1], w)
+                status = _call_force(kernel, args)
+                dof = 6
+            else:
+                for i in range(3):
+                    gp[i, 3] = Y[x0 + idx + i]
+                    vp[i] = Y[x0 + ne + idx + i]
+                args = (False, t, gp, vp, m_e[idx], no_inertia, params[p0:], fdata[f0:f1], w)
+                status = _call_force(kernel, args)
+                dof = 3
+            if status != 0:  # the failing state to io, where Python describes the failure
+                ints[I_FIELD] = status
+                _write_state(t, g, V, Y, d, io)
+                return FIELD
+            if terms[f, 4]:
+                for i in range(dof):
+                    modeled[off + i] += w[i]
+            else:
+                for i in range(dof):
+                    unmodeled[off + i] += w[i]
+        written = False
+        if d.python_parts:  # the parts without a compiled form, in Python (PythonParts)
+            _write_state(t, g, V, Y, d, io)
+            written = True
+            if _call_back(d.callback, PHASE_LOADS) != 0:
+                return CALLBACK
+            lo = d.loads_at
+            for i in range(ndof):
+                modeled[i] += io[lo + i]
+                unmodeled[i] += io[lo + ndof + i]
+        rank_at = 5 * ndof + s + 1 + nc
+        if s:  # the stacked rows, for the fused or the dense solve
+            A = np.zeros((s, ndof))
+            b = np.empty(s)
+            status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
+            if status != 0:
+                ints[I_FIELD] = status
+                _write_state(t, g, V, Y, d, io)
+                return FIELD
+        if s and d.solve == FUSED:
+            # rigid bodies only, every load seen by the solve: one compiled call
+            out = np.empty(4 * ndof + s + 3)
+            uk_rigid(V, modeled, A, b, parts.uk_params, out)
+            if out[4 * ndof + s + 2] != 0.0:  # not certified: the Python solve decides
+                if not written:
+                    _write_state(t, g, V, Y, d, io)
+                in_python = True
+            else:
+                for i in range(ndof):
+                    total[i] = out[2 * ndof + i]
+                    aux[2 * ndof + i] = out[ndof + i]
+                    aux[3 * ndof + i] = out[3 * ndof + i]
+                for i in range(s):
+                    aux[4 * ndof + i] = out[4 * ndof + i]
+                aux[4 * ndof + s] = out[4 * ndof + s]
+                aux[rank_at] = s
+        else:
+            # ν̇_a = M⁻¹(ad*_V 𝕀V + Q): Eq. 10b for rigid bodies, Q/m for point masses
+            if nr:
+                Q = np.empty((nr, 6))
+                for k in range(nr):
+                    for i in range(6):
+                        Q[k, i] = modeled[r_off[k] + i]
+                a_r = rigid_free_accel(V, J, Jinv, m_r, Q)
+                for k in range(nr):
+                    for i in range(6):
+                        total[r_off[k] + i] = a_r[k, i]
+            for i in range(ne):
+                total[e_off[i]] = modeled[e_off[i]] / m_e[i]
+            for i in range(2 * ndof, 4 * ndof + s + 1):
+                aux[i] = 0.0
+            aux[rank_at] = d.free_rank
+            if s:  # the dense strategy's certified QR solve (DenseSolver.solve_rows)
+                ac = aux[2 * ndof : 3 * ndof]
+                P = parts.uk_params
+                Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
+                residual, scale, status = _qr_solve(
+                    A, b, total, Minv_sqrt, P[0], ac, aux[4 * ndof : 4 * ndof + s]
+                )
+                if status != 0 or residual > P[1] * scale:  # the Python solve decides
+                    if not written:
+                        _write_state(t, g, V, Y, d, io)
+                    in_python = True
+                else:
+                    aux[4 * ndof + s] = residual
+                    aux[rank_at] = s
+                    _apply_M(ac, J, m_r, m_e, r_off, e_off, aux[3 * ndof : 4 * ndof])
+                    for i in range(ndof):
+                        total[i] += ac[i]
+        if not in_python:  # the controllers and the loads on the plant
+            control = aux[4 * ndof + s + 1 : 5 * ndof + s + 1]
+            for i in range(ndof):
+                control[i] = 0.0
+            ca = d.controls_at
+            if ca:  # the controllers in Python, given the modeled acceleration ν̇_a + ν̇_c
+                for i in range(ndof):
+                    io[ca + i] = total[i]
+                if _call_back(d.callback, PHASE_CONTROLS) != 0:
+                    return CALLBACK
+                for i in range(ndof):
+                    control[i] = io[ca + ndof + i]
+                for i in range(nc):
+                    z_dot[i] = io[ca + 2 * ndof + i]
+            ctrls, ctrl_params = parts.ctrls, parts.ctrl_params
+            if ctrls.shape[0]:  # the compiled controllers (their kernels' addresses in ctrls)
+                u = np.empty(6)
+                zd = np.empty(6)
+                zs = x0 + 2 * ne
+                for c in range(ctrls.shape[0]):
+                    kernel, k, o = ctrls[c, 0], ctrls[c, 1], ctrls[c, 2]
+                    z0, p0 = ctrls[c, 3], ctrls[c, 4]
+                    z = Y[zs + z0 : zs + z0 + 6]
+                    args = (t, g[k], V[k], total[o : o + 6], z, ctrl_params[p0:], u, zd)
+                    status = _call_control(kernel, args)
+                    if status != 0:
+                        ints[I_FIELD] = status
+                        _write_state(t, g, V, Y, d, io)
+                        return FIELD
+                    for i in range(6):
+                        control[o + i] += u[i]
+                        z_dot[z0 + i] = zd[i]
+            if d.plant_only:  # unmodeled loads and controls act on the plant: + M⁻¹ (Q_u + u)
+                for k in range(nr):
+                    o = r_off[k]
+                    for i in range(3):
+                        total[o + i] += (
+                            Jinv[k, i, 0] * (unmodeled[o] + control[o])
+                            + Jinv[k, i, 1] * (unmodeled[o + 1] + control[o + 1])
+                            + Jinv[k, i, 2] * (unmodeled[o + 2] + control[o + 2])
+                        )
+                        total[o + 3 + i] += (unmodeled[o + 3 + i] + control[o + 3 + i]) / m_r[k]
+                for i in range(ne):
+                    o = e_off[i]
+                    total[o] += (unmodeled[o] + control[o]) / m_e[i]
+    if in_python:
+        status = _python_accelerations(parts, aux)
         if status != DONE:
             return status
     # dY = [dexp⁻¹(ξ) V, V̇, ẋ, ẍ, ż]
@@ -241,170 +398,6 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
     for i in range(aux.shape[0]):  # the outputs too: forces, multipliers, the residual
         if not math.isfinite(aux[i]):
             return NONFINITE
-    return DONE
-
-
-@njit(cache=True, inline="always")
-def _compiled_accelerations(t, Y, g, V, parts, aux, ints):  # type: ignore[no-untyped-def]
-    """The accelerations of a FREE, FUSED or DENSE program into ``aux`` (see :func:`rhs`):
-    compiled force terms, then the parts in Python, the solve, the controllers and the loads
-    on the plant. A state whose rows the compiled QR solve cannot certify is solved in Python
-    (PHASE_ACCELERATIONS), as :meth:`System.accelerations` solves it."""
-    d = parts.dims
-    terms, params, fdata = parts.terms, parts.params, parts.field_data
-    J, Jinv, m_r, m_e = parts.J, parts.Jinv, parts.m_rigid, parts.m_euclid
-    r_off, e_off, io = parts.rigid_offsets, parts.euclid_offsets, parts.io
-    nr, ne, ndof, s, nc = d.n_rigid, d.n_euclid, d.n_dof, d.n_rows, d.n_control
-    total = aux[:ndof]
-    unmodeled = aux[ndof : 2 * ndof]
-    modeled = np.zeros(ndof)
-    for i in range(ndof):
-        unmodeled[i] = 0.0
-    w = np.empty(6)
-    x0 = 12 * nr
-    if d.point_terms:  # a point mass's pose and velocity, as its force kernels take them
-        gp = np.zeros((4, 4))
-        vp = np.zeros(6)
-        no_inertia = np.zeros((3, 3))
-    else:
-        gp = np.empty((0, 0))
-        vp = np.empty(0)
-        no_inertia = gp
-    for f in range(terms.shape[0]):
-        kernel, rig, idx, off = terms[f, 0], terms[f, 1], terms[f, 2], terms[f, 3]
-        p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]
-        if rig:
-            args = (True, t, g[idx], V[idx], m_r[idx], J[idx], params[p0:], fdata[f0:f1], w)
-            status = _call_force(kernel, args)
-            dof = 6
-        else:
-            for i in range(3):
-                gp[i, 3] = Y[x0 + idx + i]
-                vp[i] = Y[x0 + ne + idx + i]
-            args = (False, t, gp, vp, m_e[idx], no_inertia, params[p0:], fdata[f0:f1], w)
-            status = _call_force(kernel, args)
-            dof = 3
-        if status != 0:  # the failing state to io, where Python describes the failure
-            ints[I_FIELD] = status
-            _write_state(t, g, V, Y, d, io)
-            return FIELD
-        if terms[f, 4]:
-            for i in range(dof):
-                modeled[off + i] += w[i]
-        else:
-            for i in range(dof):
-                unmodeled[off + i] += w[i]
-    written = False
-    if d.python_parts:  # the parts without a compiled form, in Python (PythonParts)
-        _write_state(t, g, V, Y, d, io)
-        written = True
-        if _call_back(d.callback, PHASE_LOADS) != 0:
-            return CALLBACK
-        lo = d.loads_at
-        for i in range(ndof):
-            modeled[i] += io[lo + i]
-            unmodeled[i] += io[lo + ndof + i]
-    rank_at = 5 * ndof + s + 1 + nc
-    if s:  # the stacked rows, for the fused or the dense solve
-        A = np.zeros((s, ndof))
-        b = np.empty(s)
-        status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
-        if status != 0:
-            ints[I_FIELD] = status
-            _write_state(t, g, V, Y, d, io)
-            return FIELD
-    if s and d.solve == FUSED:
-        # rigid bodies only, every load seen by the solve: one compiled call
-        out = np.empty(4 * ndof + s + 3)
-        uk_rigid(V, modeled, A, b, parts.uk_params, out)
-        if out[4 * ndof + s + 2] != 0.0:  # not certified: the Python solve decides
-            if not written:
-                _write_state(t, g, V, Y, d, io)
-            return _python_accelerations(parts, aux)
-        for i in range(ndof):
-            total[i] = out[2 * ndof + i]
-            aux[2 * ndof + i] = out[ndof + i]
-            aux[3 * ndof + i] = out[3 * ndof + i]
-        for i in range(s):
-            aux[4 * ndof + i] = out[4 * ndof + i]
-        aux[4 * ndof + s] = out[4 * ndof + s]
-        aux[rank_at] = s
-    else:
-        # ν̇_a = M⁻¹(ad*_V 𝕀V + Q): Eq. 10b for rigid bodies, Q/m for point masses
-        if nr:
-            Q = np.empty((nr, 6))
-            for k in range(nr):
-                for i in range(6):
-                    Q[k, i] = modeled[r_off[k] + i]
-            a_r = rigid_free_accel(V, J, Jinv, m_r, Q)
-            for k in range(nr):
-                for i in range(6):
-                    total[r_off[k] + i] = a_r[k, i]
-        for i in range(ne):
-            total[e_off[i]] = modeled[e_off[i]] / m_e[i]
-        for i in range(2 * ndof, 4 * ndof + s + 1):
-            aux[i] = 0.0
-        aux[rank_at] = d.free_rank
-        if s:  # the dense strategy's certified QR solve (DenseSolver.solve_rows)
-            ac = aux[2 * ndof : 3 * ndof]
-            P = parts.uk_params
-            Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
-            residual, scale, status = _qr_solve(
-                A, b, total, Minv_sqrt, P[0], ac, aux[4 * ndof : 4 * ndof + s]
-            )
-            if status != 0 or residual > P[1] * scale:  # the Python solve decides
-                if not written:
-                    _write_state(t, g, V, Y, d, io)
-                return _python_accelerations(parts, aux)
-            aux[4 * ndof + s] = residual
-            aux[rank_at] = s
-            _apply_M(ac, J, m_r, m_e, r_off, e_off, aux[3 * ndof : 4 * ndof])
-            for i in range(ndof):
-                total[i] += ac[i]
-    control = aux[4 * ndof + s + 1 : 5 * ndof + s + 1]
-    z_dot = aux[5 * ndof + s + 1 : 5 * ndof + s + 1 + nc]
-    for i in range(ndof):
-        control[i] = 0.0
-    ca = d.controls_at
-    if ca:  # the controllers in Python, given the modeled acceleration ν̇_a + ν̇_c
-        for i in range(ndof):
-            io[ca + i] = total[i]
-        if _call_back(d.callback, PHASE_CONTROLS) != 0:
-            return CALLBACK
-        for i in range(ndof):
-            control[i] = io[ca + ndof + i]
-        for i in range(nc):
-            z_dot[i] = io[ca + 2 * ndof + i]
-    ctrls, ctrl_params = parts.ctrls, parts.ctrl_params
-    if ctrls.shape[0]:  # the compiled controllers (their kernels' addresses in ctrls)
-        u = np.empty(6)
-        zd = np.empty(6)
-        zs = x0 + 2 * ne
-        for c in range(ctrls.shape[0]):
-            kernel, k, o, z0, p0 = ctrls[c, 0], ctrls[c, 1], ctrls[c, 2], ctrls[c, 3], ctrls[c, 4]
-            z = Y[zs + z0 : zs + z0 + 6]
-            args = (t, g[k], V[k], total[o : o + 6], z, ctrl_params[p0:], u, zd)
-            status = _call_control(kernel, args)
-            if status != 0:
-                ints[I_FIELD] = status
-                _write_state(t, g, V, Y, d, io)
-                return FIELD
-            for i in range(6):
-                control[o + i] += u[i]
-                z_dot[z0 + i] = zd[i]
-    if d.plant_only:  # unmodeled loads and controls act on the plant: + M⁻¹ (Q_u + u)
-        for k in range(nr):
-            o = r_off[k]
-            for i in range(3):
-                total[o + i] += (
-                    Jinv[k, i, 0] * (unmodeled[o] + control[o])
-                    + Jinv[k, i, 1] * (unmodeled[o + 1] + control[o + 1])
-                    + Jinv[k, i, 2] * (unmodeled[o + 2] + control[o + 2])
-                )
-                total[o + 3 + i] += (unmodeled[o + 3 + i] + control[o + 3 + i]) / m_r[k]
-        for i in range(ne):
-            o = e_off[i]
-            total[o] += (unmodeled[o] + control[o]) / m_e[i]
     return DONE
 
 
