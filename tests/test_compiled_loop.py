@@ -473,8 +473,9 @@ def test_compiled_rows_find_rigid_bodies_after_point_masses_under_the_dense_solv
     assert isinstance(prog, program_records.Program), prog
     assert prog.parts.dims.solve == program_records.DENSE and prog.s == 12
     _assert_same_right_hand_sides(system, state, prog)
+    # RK4 at 5 s steps leaves the constraint (3e-5 m/s in 300 s): the comparison is the point
     kw = {"method": "RK4", "step": 5.0, "t_eval": np.linspace(0, 300, 7)}
-    fast = system.simulate(state, (0.0, 300.0), **kw)
+    fast = system.simulate(state, (0.0, 300.0), drift_tol=None, **kw)
     slow = reference_simulate(system, state, (0.0, 300.0), **kw)
     assert fast.stats["compiled"] and fast.stats["n_rhs"] == slow.stats["n_rhs"]
     np.testing.assert_allclose(fast.g_NB, slow.g_NB, rtol=0, atol=1e-13 * 4e6)
