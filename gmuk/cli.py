@@ -43,17 +43,18 @@ blocks the next one.
 ``gmuk view`` writes an interactive 3-D view of a run (:mod:`gmuk.view`): one HTML file that
 opens offline in a browser. ``gmuk run`` writes it as ``DIR/view.html`` unless ``--no-plots``,
 loading plotly.js from one shared copy in DIR's parent folder (``plotly-<version>.min.js``,
-written once: docs/view.rst); ``gmuk view`` writes a self-contained page.
+written once: docs/view.rst); ``gmuk view`` writes a self-contained page. ``--out`` names the
+HTML file; given an existing folder, ``gmuk view`` writes ``view.html`` into it (as ``cp FILE
+DIR`` does). The trajectory file is checked as :func:`gmuk.load_trajectory` checks it; a file
+it refuses, or an output it cannot write, stops with a message and exit status 2.
 
 What a run spends its time on: any phase longer than 2 s (loading or compiling the step loop,
 simulating, the figures, ...) says so on stderr when 2 s have passed and how long it took when
 it ends (on a terminal, the simulation also shows a progress bar); ``summary.json``'s
-``time_s`` gives each phase's wall time (s) and their total, and ``wall_time_s`` is the
-simulation's. ``--csv`` also writes the primary run as ``DIR/trajectory.csv``.
-``--out`` names the HTML file; given an existing folder, ``gmuk view`` writes ``view.html``
-into it (as ``cp FILE DIR`` does). The trajectory file is checked as
-:func:`gmuk.load_trajectory` checks it; a file it refuses, or an output it cannot write,
-stops with a message and exit status 2.
+``time_s`` gives each phase's wall time (s) and their total — ``loop``: loading or compiling
+the step loop, ``compile``: compiling the parts' kernels on first use (both once per machine),
+``simulation``: the rest of the scenario's run — and ``wall_time_s`` is the simulation's.
+``--csv`` also writes the primary run as ``DIR/trajectory.csv``.
 
 ``gmuk check`` prints the table of :func:`gmuk.check <gmuk.crosscheck.check>` and exits 0 if
 every quantity agrees with Pinocchio within its tolerance, 1 if any does not.
@@ -73,6 +74,8 @@ from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from types import FrameType
 from typing import Any, NoReturn
+
+from numba.core import event as numba_event
 
 from gmuk import runs, scenarios
 from gmuk._locks import folder_lock
@@ -257,6 +260,18 @@ class _Phases:
             if announced.is_set():
                 print(f"gmuk: {self.name}: {doing}: {elapsed:.1f} s", file=sys.stderr, flush=True)
 
+    def split(self, key: str, part: str, seconds: float) -> None:
+        """Count ``seconds`` of phase ``key`` as phase ``part`` instead, listed before it."""
+        seconds = min(seconds, self.times[key])
+        order = list(self.times)
+        self.times = {
+            **{k: self.times[k] for k in order[: order.index(key)]},
+            part: self.times.get(part, 0.0) + seconds,
+            **{
+                k: self.times[k] - (seconds if k == key else 0.0) for k in order[order.index(key) :]
+            },
+        }
+
     def summary(self) -> dict[str, float]:
         """``summary.json``'s ``time_s``: each phase's wall time and their total (s)."""
         return {
@@ -403,7 +418,11 @@ def _run_owned(
     with runs.run_control(folder, every_s=every, resume=args.resume is not None) as control:
         with _stopping_signals(control) as received:
             with phases.phase("simulation", f"simulating{f' ({shown})' if shown else ''}"):
-                result = scenario.run(**options)
+                # the parts' kernels compile on first use (once per machine): timed apart
+                jit = numba_event.TimingListener()
+                with numba_event.install_listener("numba:compile", jit):
+                    result = scenario.run(**options)
+    phases.split("simulation", "compile", jit.duration if jit.done else 0.0)
     elapsed = phases.times["simulation"]
     primary = result.trajectories[result.primary]
     stopped = [k for k, v in result.trajectories.items() if v.status not in ("success", "drifted")]

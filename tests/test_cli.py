@@ -7,6 +7,7 @@ run through ``gmuk.cli.main`` with its own options.
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import json
 from pathlib import Path
@@ -238,7 +239,7 @@ def test_a_run_says_what_it_is_doing_and_what_its_time_went_to(
         assert f"gmuk: tumble: {doing}" in err, err
     assert "gmuk: tumble: drawing the figures: " in err and "3-D view" in err
     times = json.loads((out / "summary.json").read_text())["time_s"]
-    phases = ["loop", "simulation", "save", "csv", "figures", "view"]
+    phases = ["loop", "compile", "simulation", "save", "csv", "figures", "view"]
     assert list(times) == [*phases, "total"]
     assert times["total"] == pytest.approx(sum(times[k] for k in phases), abs=1e-2)
     header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
@@ -343,6 +344,38 @@ def test_an_impossible_span_or_output_folder_is_a_clear_error(tmp_path, capsys):
     blocker.write_text("not a folder")
     assert cli.main(["run", "fcei", "--orbits", "0.01", "--out", str(blocker / "sub")]) == 2
     assert "cannot make the output folder" in capsys.readouterr().err
+
+
+def test_the_parts_compile_time_is_counted_apart_from_the_simulation():
+    """Numba's compile events inside the scenario's run go to time_s["compile"] (listed
+    before the simulation), and the simulation keeps the rest."""
+    phases = cli._Phases("x")
+    for key in ("loop", "simulation", "save"):
+        with phases.phase(key, None):
+            pass
+    phases.times.update(loop=1.0, simulation=5.0, save=0.5)
+    phases.split("simulation", "compile", 3.0)
+    assert phases.times == {"loop": 1.0, "compile": 3.0, "simulation": 2.0, "save": 0.5}
+    phases.split("simulation", "compile", 9.0)  # never more than the phase had
+    assert phases.times["simulation"] == 0.0 and phases.times["compile"] == 5.0
+    assert phases.summary()["total"] == 6.5
+
+
+def compiling_tumble_run(
+    spin: float = 1.0, moments: tuple[float, ...] = (1.0, 2.0, 3.0), duration: float = 5.0
+) -> ScenarioResult:
+    """tumble_run after compiling a kernel of its own (a new one each time: never cached)."""
+    numba.njit(lambda x: x + 1.0)(1.0)
+    return tumble_run(spin, moments, duration)
+
+
+def test_a_run_that_compiles_says_so_in_its_time(plugins, tmp_path):
+    plugins(_EntryPoint("tumble", lambda: dataclasses.replace(TUMBLE, run=compiling_tumble_run)))
+    out = tmp_path / "c"
+    argv = ["run", "tumble", "--duration", "0.5", "--no-plots", "--out", str(out)]
+    assert cli.main(argv) == 0
+    times = json.loads((out / "summary.json").read_text())["time_s"]
+    assert times["compile"] > 0.0 and times["simulation"] >= 0.0
 
 
 def test_a_summary_of_cases_prints_as_one_table():
