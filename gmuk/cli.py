@@ -3,8 +3,7 @@
     gmuk --version
     gmuk list
     gmuk plugins
-    gmuk run [NAME] [--out DIR] [--no-plots] [--csv] [--format FMT] [--checkpoint-every S]
-             [options]
+    gmuk run [NAME] [--out DIR] [--no-plots] [--csv] [--format FMT] [--checkpoint-every S] [...]
     gmuk run [NAME] --resume DIR
     gmuk run NAME --help
     gmuk check [--seed S] [--samples N] [--verbose]
