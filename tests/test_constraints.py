@@ -159,6 +159,27 @@ def test_tracking_constraint_b_is_eq_67_on_the_constraint_and_projected_off_it()
     assert np.allclose(b_off, np.concatenate([so3.vee(W), X[:3, 3]]), atol=1e-12)
 
 
+def test_tracking_calls_its_kernels_with_the_compiled_loops_types_from_a_read_only_state():
+    """A State's arrays are read-only; the Python forms of tracking pass its kernels writable
+    copies, so numba compiles each kernel for one type only, the compiled loop's (a read-only
+    array type would be a second compilation on a fresh machine, seconds each)."""
+    import numba
+
+    from gmuk.constraints import tracking
+
+    rng = np.random.default_rng(5)
+    (body,) = random_rigid_bodies(rng, 1)
+    con = gmuk.ConfigurationTracking(body, ScrewReference(np.eye(4), rng.normal(size=6)))
+    state = random_state(gmuk.System([body], [con]), rng)
+    assert not state.g.flags.writeable
+    con.rows(state)
+    con.violation(state)
+    for kernel in (tracking.tracking_rows, tracking.tracking_b, tracking._errors):
+        arrays = [a for sig in kernel.signatures for a in sig if isinstance(a, numba.types.Array)]
+        assert all(a.mutable for a in arrays), (kernel.__name__, kernel.signatures)
+    assert tracking.tracking_rows.signatures and tracking._errors.signatures  # both were called
+
+
 def test_eq80_takes_exactly_one_constraint_while_reachable_rows_stack():
     a = gmuk.RigidBody("a", 1.0, np.eye(3))
     ref = ScrewReference(np.eye(4), np.array([0.01, 0.02, -0.03, 1.0, 0.0, 0.5]))

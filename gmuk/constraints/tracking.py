@@ -146,11 +146,13 @@ def tracking_errors(
         ``V − Ad_{g⁻¹ g_d} V_d``: the body twist of g_d⁻¹g (rad/s, m/s).
     """
     e_g, e_V = np.empty(6), np.empty(6)
+    # writable copies: a read-only array (a State's) would make numba compile the kernel once
+    # more, for that type, beside the writable one the compiled loop uses
     _errors(
-        np.asarray(g, dtype=np.float64),
-        np.asarray(V, dtype=np.float64),
-        np.asarray(g_d, dtype=np.float64),
-        np.asarray(V_d, dtype=np.float64),
+        np.array(g, dtype=np.float64),
+        np.array(V, dtype=np.float64),
+        np.array(g_d, dtype=np.float64),
+        np.array(V_d, dtype=np.float64),
         e_g,
         e_V,
     )
@@ -309,7 +311,7 @@ class ConfigurationTracking(Constraint):
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
         """A = I₆ and b of Eq. 67 (projected), plus Baumgarte terms."""
         (i,) = self._rigid_indices(state)
-        g, V = state.g[i], state.V[i]
+        g, V = state.g[i].copy(), state.V[i].copy()  # writable, as below: a State's are not
         ref = self.reference.evaluate(state.t)
         gd, Vd, Vd_dot = ref.g, ref.V, ref.V_dot
         # The kernel takes writable float64 arrays, as the compiled loop passes them (one
@@ -328,6 +330,6 @@ class ConfigurationTracking(Constraint):
                 f"V_dot {Vd_dot.shape}; expected (4, 4), (6,), (6,)"
             )
         b = _empty(6)  # filled by the kernel (cheaper than a kernel returning an array)
-        gains = self._gains
+        gains = self._gains.copy()  # writable: frozen in a System, the attribute is not
         tracking_rows(g, V, gd, Vd, Vd_dot, self.baumgarte is not None, gains[0], gains[1], b)
         return _EYE6, b
