@@ -115,8 +115,13 @@ def table() -> None:
         )
 
 
-def slew() -> None:
-    """Minimum-effort rest-to-rest slew of one rigid body, 90° about (1, 1, 1)/√3 in 60 s."""
+def slew_rows(elements: tuple[int, ...] = (6, 12, 24, 48)) -> list[dict[str, float]]:
+    """Minimum-effort rest-to-rest slew of one rigid body, 90° about (1, 1, 1)/√3 in 60 s,
+    degree 4, on each number of ``elements``: per mesh the objective, the largest
+    orthogonality error max(|RᵀR − I|, |det R − 1|), the final attitude error (rad), the
+    largest error of its re-simulation by System.simulate at the nodes (rad; DOP853, rtol
+    1e-11), IPOPT's iterations and the wall time (s). docs/optimize.rst's table; its figures
+    are checked by tests/docs_figures.py, which calls this."""
     import numpy as np
 
     import gmuk
@@ -129,32 +134,50 @@ def slew() -> None:
     gf = np.eye(4)
     gf[:3, :3] = so3.exp(0.5 * np.pi * np.ones(3) / np.sqrt(3.0))
     final = {"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
-    print("rigid-body slew, degree 4; re-simulated with System.simulate (DOP853, rtol 1e-11)")
-    print(
-        "| elements | objective | max(|RᵀR − I|, |det R − 1|) | final attitude error (rad) | "
-        "re-simulated, max error at the nodes (rad) | IPOPT iterations | total (s) |"
-    )
-    print("|---:|---:|---:|---:|---:|---:|---:|")
-    for n in (6, 12, 24, 48):
+    rows = []
+    for n in elements:
         tic = time.perf_counter()
         r = OptimalControlProblem(system, state, 60.0, final=final).solve(
             Mesh.uniform(0.0, 60.0, n, 4)
         )
         total = time.perf_counter() - tic
         R = r.R_NB[:, 0]
-        orth = max(
-            np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(),
-            np.abs(np.linalg.det(R) - 1.0).max(),
-        )
         driven = gmuk.System([body], controllers=[r.controller()])
         traj = driven.simulate(state, (0.0, 60.0), t_eval=r.t, rtol=1e-11, atol=1e-12)
-        err = np.linalg.norm(
-            so3.log(np.swapaxes(traj.g_NB[:, 0, :3, :3], -1, -2) @ R), axis=-1
-        ).max()
-        final_err = np.linalg.norm(so3.log(R[-1].T @ gf[:3, :3]))
+        rows.append(
+            {
+                "elements": n,
+                "objective": r.objective,
+                "orthogonality": max(
+                    np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(),
+                    np.abs(np.linalg.det(R) - 1.0).max(),
+                ),
+                "final_error": float(np.linalg.norm(so3.log(R[-1].T @ gf[:3, :3]))),
+                "resimulated_error": float(
+                    np.linalg.norm(
+                        so3.log(np.swapaxes(traj.g_NB[:, 0, :3, :3], -1, -2) @ R), axis=-1
+                    ).max()
+                ),
+                "iterations": r.iterations,
+                "total_s": total,
+            }
+        )
+    return rows
+
+
+def slew() -> None:
+    """Print :func:`slew_rows` as docs/optimize.rst's table."""
+    print("rigid-body slew, degree 4; re-simulated with System.simulate (DOP853, rtol 1e-11)")
+    print(
+        "| elements | objective | max(|RᵀR − I|, |det R − 1|) | final attitude error (rad) | "
+        "re-simulated, max error at the nodes (rad) | IPOPT iterations | total (s) |"
+    )
+    print("|---:|---:|---:|---:|---:|---:|---:|")
+    for row in slew_rows():
         print(
-            f"| {n} | {r.objective:.10e} | {orth:.1e} | {final_err:.1e} | {err:.1e} | "
-            f"{r.iterations} | {total:.2f} |"
+            f"| {row['elements']} | {row['objective']:.10e} | {row['orthogonality']:.1e} | "
+            f"{row['final_error']:.1e} | {row['resimulated_error']:.1e} | "
+            f"{row['iterations']} | {row['total_s']:.2f} |"
         )
 
 

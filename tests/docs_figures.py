@@ -1930,37 +1930,22 @@ for _m, (_mu_g, _offset, _rhs) in _SLACK_MASS_ROWS.items():
 
 
 def _slew_table() -> dict[str, Any]:
-    """docs/optimize.rst's rigid-body slew table (benchmarks/bench_optimize.py --slew-only):
-    90° rest to rest about (1, 1, 1)/√3 in 60 s, degree 4, on 6 to 48 elements."""
-    import gmuk
-    from gmuk.lie import so3
-    from gmuk.optimize import Mesh, OptimalControlProblem
+    """docs/optimize.rst's rigid-body slew table (benchmarks/bench_optimize.py --slew-only,
+    whose ``slew_rows`` computes it): 90° rest to rest about (1, 1, 1)/√3 in 60 s, degree 4,
+    on 6 to 48 elements."""
+    import importlib.util
 
-    J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
-    body = gmuk.RigidBody("sat", 100.0, J)
-    system = gmuk.System([body])
-    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
-    gf = np.eye(4)
-    gf[:3, :3] = so3.exp(0.5 * np.pi * np.ones(3) / np.sqrt(3.0))
-    final = {"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
-    out: dict[str, Any] = {}
-    for n in (6, 12, 24, 48):
-        r = OptimalControlProblem(system, state, 60.0, final=final).solve(
-            Mesh.uniform(0.0, 60.0, n, 4)
-        )
-        R = r.R_NB[:, 0]
-        out[f"{n}/objective"] = r.objective
-        out[f"{n}/orthogonality"] = max(
-            np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(),
-            np.abs(np.linalg.det(R) - 1.0).max(),
-        )
-        out[f"{n}/final_error"] = float(np.linalg.norm(so3.log(R[-1].T @ gf[:3, :3])))
-        driven = gmuk.System([body], controllers=[r.controller()])
-        traj = driven.simulate(state, (0.0, 60.0), t_eval=r.t, rtol=1e-11, atol=1e-12)
-        out[f"{n}/resimulated_error"] = float(
-            np.linalg.norm(so3.log(np.swapaxes(traj.g_NB[:, 0, :3, :3], -1, -2) @ R), axis=-1).max()
-        )
-    return out
+    spec = importlib.util.spec_from_file_location(
+        "bench_optimize", ROOT / "benchmarks" / "bench_optimize.py"
+    )
+    assert spec is not None and spec.loader is not None
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    return {
+        f"{row['elements']}/{key}": row[key]
+        for row in bench.slew_rows()
+        for key in ("objective", "orthogonality", "final_error", "resimulated_error")
+    }
 
 
 RUNS["optimize-slew"] = Run(
