@@ -157,18 +157,24 @@ def honest_real(x: Any) -> bool:
     return False
 
 
-def regular_array(x: Any, shape: tuple[int, ...]) -> np.ndarray | None:
-    """``x`` as a float array if it is honest real data of exactly ``shape`` (after the
-    conversion numpy would do), else None."""
+def real_array(x: Any) -> np.ndarray | None:
+    """``x`` as a float array if it is honest real data (after the conversion numpy would
+    do; any shape, finite or not), else None."""
     if not honest_real(x):
         return None
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            a = np.asarray(x, dtype=float)
+            return np.asarray(x, dtype=float)
     except (TypeError, ValueError, OverflowError):
         return None
-    return a if a.shape == shape else None
+
+
+def regular_array(x: Any, shape: tuple[int, ...]) -> np.ndarray | None:
+    """``x`` as a float array if it is honest real data of exactly ``shape`` (after the
+    conversion numpy would do), else None."""
+    a = real_array(x)
+    return a if a is not None and a.shape == shape else None
 
 
 # --------------------------------------------------------------------------- strategies

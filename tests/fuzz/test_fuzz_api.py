@@ -15,7 +15,17 @@ import math
 
 import numpy as np
 import pytest
-from fuzz_inputs import REFUSED, arrays, fuzz_pair, honest_real, numbers, outcome, poses, scalars
+from fuzz_inputs import (
+    REFUSED,
+    arrays,
+    fuzz_pair,
+    honest_real,
+    numbers,
+    outcome,
+    poses,
+    real_array,
+    scalars,
+)
 from hypothesis import strategies as st
 
 import gmuk
@@ -26,12 +36,8 @@ from gmuk.lie import se3
 
 def _regular(x, tail):
     """``x`` as float if honest real with trailing shape ``tail``, finite; else None."""
-    if not honest_real(x):
-        return None
-    try:
-        with np.errstate(all="ignore"):
-            a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError, OverflowError):
+    a = real_array(x)
+    if a is None:
         return None
     k = len(tail)
     if a.ndim < k or a.shape[a.ndim - k :] != tail or not np.isfinite(a).all():

@@ -25,7 +25,16 @@ from typing import Any
 
 import numpy as np
 import pytest
-from fuzz_inputs import REFUSED, arrays, fuzz_pair, honest_real, junk, outcome, scalars
+from fuzz_inputs import (
+    REFUSED,
+    arrays,
+    fuzz_pair,
+    honest_real,
+    junk,
+    outcome,
+    regular_array,
+    scalars,
+)
 from hypothesis import strategies as st
 
 import gmuk
@@ -55,14 +64,8 @@ def _honest(value: Any, shape: tuple[int, ...]) -> bool:
 
 def _acceptable(value: Any, shape: tuple[int, ...]) -> bool:
     """What may be accepted: honest real data of ``shape`` (any finite size)."""
-    if not honest_real(value):
-        return False
-    try:
-        with np.errstate(all="ignore"):
-            a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError, OverflowError):
-        return False
-    return a.shape == shape and bool(np.isfinite(a).all())
+    a = regular_array(value, shape)
+    return a is not None and bool(np.isfinite(a).all())
 
 
 class Script:

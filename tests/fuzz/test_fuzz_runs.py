@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fuzz_inputs import REFUSED, fuzz_pair, honest_real, junk, outcome, scalars
+from helpers import StopAt
 from hypothesis import strategies as st
 
 import gmuk
@@ -153,20 +154,6 @@ def check_accessors(args) -> None:
 
 
 # ------------------------------------------------------------------ checkpoints, resume
-class StopAt(gmuk.ForceModel):
-    """No force; asks the enclosing run to stop once t passes ``t_stop``."""
-
-    def __init__(self, t_stop):
-        super().__init__(name="stop")
-        self.t_stop = t_stop
-
-    def force(self, t, r_N, v_N, body):
-        control = runs.current()
-        if control is not None and t > self.t_stop:
-            control.request_stop()
-        return np.zeros(3)
-
-
 def _pendulum(t_stop):
     bob = gmuk.PointMass("bob", 0.4)
     system = gmuk.System(
