@@ -6,12 +6,16 @@ Cases (meshes uniform):
 
 * bounded spring–mass–damper (tests/optimize/handwritten_lobatto.py's problem; gmuk solves
   the ``smd-bi`` System, a 3-D point mass with the spring–damper and the PlaneBound), 150
-  elements of degree 3 and of degree 4. GEKKO twice: on the same elements and nodes
+  elements of degree 3 and of degree 4. The hand transcription twice: of the 1-D problem,
+  and of the NLP gmuk poses (the point mass in R³, three times the variables; the same
+  optimum). GEKKO twice: on the same elements and nodes
   (``NODES = degree + 1``) and with ``NODES = 2`` on as many time points as the mesh has
   nodes (gekko_smd.py's docstring says why both, and why ``NODES = 5`` is not a usable
   discretisation of this problem);
 * the rigid-body rest-to-rest slew of docs/optimize.rst (benchmarks/bench_optimize.py's
-  slew_rows, without its re-simulation), 40 elements of degree 4.
+  slew_rows, without its re-simulation), 40 elements of degree 4. The hand transcription
+  (unit quaternions) twice: the attitude alone, and with the translational part gmuk's
+  rigid body carries (its NLP's variables, the same optimum).
 
 All in one process: per case, one warm-up run of every solver, then ``--repeat`` rounds in
 which the solvers take turns, so that the load of the (shared) machine falls on all alike.
@@ -131,6 +135,16 @@ def hand(solve: Callable[[int, int], HandResult], n_elements: int, degree: int) 
     return run
 
 
+def smd_3d(n_elements: int, degree: int) -> HandResult:
+    """The hand-written SMD on the NLP gmuk poses: a point mass in R³ (``dim=3``)."""
+    return smd_mapped(n_elements, degree, dim=3)
+
+
+def slew_with_translation(n_elements: int, degree: int) -> HandResult:
+    """The hand-written slew with the translational part gmuk carries (``translation``)."""
+    return slew_mapped(n_elements, degree, translation=True)
+
+
 def gekko(n_elements: int, degree: int, same_nodes: bool) -> Runner:
     """GEKKO on the SMD."""
 
@@ -152,7 +166,8 @@ def cases() -> list[tuple[str, dict[str, Runner]]]:
                 f"bounded SMD, {n} elements of degree {p} ({n * p + 1} nodes)",
                 {
                     "gmuk": gmuk_smd(n, p),
-                    "hand-written CasADi, mapped": hand(smd_mapped, n, p),
+                    "hand-written CasADi, mapped, 1-D": hand(smd_mapped, n, p),
+                    "hand-written CasADi, mapped, 3-D (gmuk's NLP)": hand(smd_3d, n, p),
                     f"GEKKO, same nodes (NODES={p + 1})": gekko(n, p, True),
                     f"GEKKO, NODES=2 on {n * p + 1} points": gekko(n, p, False),
                 },
@@ -161,7 +176,13 @@ def cases() -> list[tuple[str, dict[str, Runner]]]:
     out.append(
         (
             "rigid-body slew, 40 elements of degree 4 (161 nodes)",
-            {"gmuk": gmuk_slew(40, 4), "hand-written CasADi, mapped": hand(slew_mapped, 40, 4)},
+            {
+                "gmuk": gmuk_slew(40, 4),
+                "hand-written CasADi, mapped, attitude only": hand(slew_mapped, 40, 4),
+                "hand-written CasADi, mapped, with translation (gmuk's NLP)": hand(
+                    slew_with_translation, 40, 4
+                ),
+            },
         )
     )
     return out

@@ -224,6 +224,7 @@ def smd_mapped(
     b: float = 5.0,
     k: float = 10.0,
     symbols: str = "MX",
+    dim: int = 1,
 ) -> HandResult:
     """The bounded spring–mass–damper of tests/optimize/handwritten_lobatto.py, mapped.
 
@@ -246,27 +247,38 @@ def smd_mapped(
         Mass (kg), damping (N·s/m), stiffness (N/m).
     symbols : {"MX", "SX"}
         The symbols of the mesh-level NLP (module docstring).
+    dim : {1, 3}
+        1: the 1-D problem above. 3: the NLP gmuk poses for the ``smd-bi`` System, a point
+        mass in R³ with the isotropic spring–damper (−k r − b v), a control force on each
+        axis, the bound on the first coordinate, at rest at the origin in the other two;
+        y = (r, v), u (3,), cost ∫ |u|²/m dt. The optimum is the same (the other axes stay
+        at rest with zero control); the NLP is three times the size.
 
     Returns
     -------
     HandResult
     """
     tic = time.perf_counter()
-    col = _Collocation(2, 1, n_elements, degree, t_final)
+    if dim not in (1, 3):
+        raise ValueError(f"dim must be 1 or 3; got {dim!r}")
+    col = _Collocation(2 * dim, dim, n_elements, degree, t_final)
 
     def rhs(y: Any, u: Any) -> Any:
-        return ca.vertcat(y[1], (u[0] - k * y[0] - b * y[1]) / m)
+        return ca.vertcat(y[dim:], (u - k * y[:dim] - b * y[dim:]) / m)
 
     def running_cost(y: Any, u: Any) -> Any:
-        return u[0] ** 2 / m
+        return ca.sumsqr(u) / m
 
     w, g, f = col.nlp(col.element_function(rhs, running_cost), symbols)
     N = col.n_nodes
-    lbw = np.full((N, 3), -np.inf)
-    ubw = np.full((N, 3), np.inf)
+    lbw = np.full((N, 3 * dim), -np.inf)
+    ubw = np.full((N, 3 * dim), np.inf)
     lbw[1:, 0], ubw[1:, 0] = lower, upper
-    lbw[0, :2] = ubw[0, :2] = (x0, v0)  # the initial state is fixed by its bounds
-    guess = np.tile([np.clip(x0, lower, upper), v0, 0.0], (N, 1))
+    start = np.zeros(3 * dim)
+    start[0], start[dim] = x0, v0
+    lbw[0, : 2 * dim] = ubw[0, : 2 * dim] = start[: 2 * dim]  # the initial state, by bounds
+    start[0] = np.clip(x0, lower, upper)
+    guess = np.tile(start, (N, 1))
     zeros = np.zeros(g.shape[0])
     bounds = (lbw.reshape(-1), ubw.reshape(-1), zeros, zeros)
     return _solve("smd_mapped", col, w, f, g, bounds, guess.reshape(-1), tic)
@@ -293,6 +305,7 @@ def slew_mapped(
     axis: tuple[float, float, float] = (1.0, 1.0, 1.0),
     inertia: np.ndarray = SLEW_INERTIA,
     symbols: str = "MX",
+    translation: bool = False,
 ) -> HandResult:
     """Minimum-effort rest-to-rest slew of one free rigid body, mapped.
 
@@ -333,25 +346,41 @@ def slew_mapped(
         J (3 × 3, kg m²).
     symbols : {"MX", "SX"}
         The symbols of the mesh-level NLP (module docstring).
+    translation : bool
+        Also the translational part, as gmuk poses it: the position r_N (m) and the
+        body-frame velocity v_B (m/s) as states, ṙ_N = R(q) v_B and
+        v̇_B = v_B × ω + f_B/m, the body-frame force f_B (N) as a control with cost
+        ∫ f_Bᵀ f_B/m dt, at rest at the origin at both ends (gmuk's final pose fixes the
+        position too). The optimum is the same (f = 0); the NLP is about twice the size.
 
     Returns
     -------
     HandResult
-        States y = (q_w, q_x, q_y, q_z, ω_x, ω_y, ω_z) and controls u = L (N m) at the nodes.
+        States y = (q_w, q_x, q_y, q_z, ω_x, ω_y, ω_z[, r_N, v_B]) and controls
+        u = L (N m)[, f_B (N)] at the nodes.
     """
     tic = time.perf_counter()
-    col = _Collocation(7, 3, n_elements, degree, t_final)
+    n_y, n_u = (13, 6) if translation else (7, 3)
+    col = _Collocation(n_y, n_u, n_elements, degree, t_final)
     J = ca.DM(inertia)
     J_inv = ca.DM(np.linalg.inv(inertia))
 
     def rhs(y: Any, u: Any) -> Any:
-        q, omega = y[:4], y[4:]
+        q, omega = y[:4], y[4:7]
         q_dot = 0.5 * _quat_mul(q, ca.vertcat(0.0, omega))
-        omega_dot = J_inv @ (u - ca.cross(omega, J @ omega))
-        return ca.vertcat(q_dot, omega_dot)
+        omega_dot = J_inv @ (u[:3] - ca.cross(omega, J @ omega))
+        if not translation:
+            return ca.vertcat(q_dot, omega_dot)
+        v = y[10:13]
+        # R(q) v = v + 2 q_w (q_v × v) + 2 q_v × (q_v × v) for a unit quaternion
+        qv_x_v = ca.cross(q[1:4], v)
+        r_dot = v + 2.0 * q[0] * qv_x_v + 2.0 * ca.cross(q[1:4], qv_x_v)
+        v_dot = ca.cross(v, omega) + u[3:] / SLEW_MASS
+        return ca.vertcat(q_dot, omega_dot, r_dot, v_dot)
 
     def running_cost(y: Any, u: Any) -> Any:
-        return u.T @ (J_inv @ u)
+        cost = u[:3].T @ (J_inv @ u[:3])
+        return cost + ca.sumsqr(u[3:]) / SLEW_MASS if translation else cost
 
     w, g_dyn, f = col.nlp(col.element_function(rhs, running_cost), symbols)
     n_hat = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
@@ -363,14 +392,15 @@ def slew_mapped(
     g = ca.vertcat(g_dyn, _quat_mul(q_conj, q_end)[1:])
     lbw = np.full((N, nz), -np.inf)
     ubw = np.full((N, nz), np.inf)
-    lbw[0, :7] = ubw[0, :7] = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # at rest, identity
-    lbw[-1, 4:7] = ubw[-1, 4:7] = 0.0  # at rest at the end
+    lbw[0, :n_y] = ubw[0, :n_y] = 0.0
+    lbw[0, 0] = ubw[0, 0] = 1.0  # at rest, identity (and at the origin)
+    lbw[-1, 4:n_y] = ubw[-1, 4:n_y] = 0.0  # at rest at the end (and at the origin)
     s = col.times() / t_final
     guess = np.zeros((N, nz))
     guess[:, 0] = np.cos(0.5 * angle * s)
     guess[:, 1:4] = np.sin(0.5 * angle * s)[:, None] * n_hat
     guess[:, 4:7] = phi / t_final
-    guess[-1, 4:7] = 0.0  # inside the bounds
+    guess[-1, 4:7] = 0.0  # inside the bounds (r, v and f: 0)
     zeros = np.zeros(g.shape[0])
     bounds = (lbw.reshape(-1), ubw.reshape(-1), zeros, zeros)
     return _solve("slew_mapped", col, w, f, g, bounds, guess.reshape(-1), tic)

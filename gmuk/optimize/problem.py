@@ -61,7 +61,7 @@ from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.inequality import InequalityConstraint
 from gmuk.errors import DefinitionError, OptimizationError
 from gmuk.lie import so3
-from gmuk.optimize import _so3, parts
+from gmuk.optimize import _blocks, _so3, parts
 from gmuk.optimize.lgl import lgl_integration_matrix, lgl_nodes
 from gmuk.optimize.mesh import Mesh, split_counts
 from gmuk.optimize.result import OptimalControlResult, PathConstraintResult, RefinementStep
@@ -81,6 +81,12 @@ CALIBRATION_ELEMENTS = (16, 64)
 
 #: Factor on the build time extrapolated from the partial meshes (see above).
 BUILD_MARGIN = 1.5
+
+#: Meshes of one degree and at most this many elements are built without timing a part
+#: first: their build is one element's symbolic work and then, per element, only index
+#: arithmetic and sparse assembly (``_blocks``), small beside any budget (under a second at
+#: this size: ``benchmarks/README.md``), and the build checks the clock as it goes.
+UNTIMED_ELEMENTS = 1000
 
 #: IPOPT options set by :meth:`OptimalControlProblem.solve`'s own arguments.
 _RESERVED_OPTIONS = {
@@ -463,9 +469,10 @@ class OptimalControlProblem:
         max_cpu_time : float
             The time budget (s) of the whole call, building the NLP and solving it: IPOPT
             gets what the build left as its CPU- and wall-time limits. A mesh of more than
-            64 elements is first timed on 16 (and 64) of its elements, and refused up
-            front when building it all would not fit in the budget; the build checks the
-            clock as it goes. The call returns or raises within about ``max_cpu_time``.
+            1000 elements (64 if its elements' degrees differ) is first timed on 16 (and 64)
+            of its elements, and refused up front when building it all would not fit in the
+            budget; the build checks the clock as it goes. The call returns or raises within
+            about ``max_cpu_time``.
         tol : float
             IPOPT's convergence tolerance (> 0).
         log : bool
@@ -552,9 +559,10 @@ class OptimalControlProblem:
         Building the NLP (CasADi's derivatives and IPOPT's set-up, one call each that
         cannot be interrupted) costs about the same per element; it is timed on the first
         16 elements and, if those suggest the whole might not fit, on the first 64, and
-        the mean cost per element extrapolated to the mesh."""
+        the mean cost per element extrapolated to the mesh. Not for meshes of one degree
+        up to :data:`UNTIMED_ELEMENTS` elements, whose build is cheap (its note)."""
         K = mesh.n_elements
-        if K <= CALIBRATION_ELEMENTS[-1]:
+        if K <= CALIBRATION_ELEMENTS[-1] or (K <= UNTIMED_ELEMENTS and len(set(mesh.degrees)) == 1):
             return
         small, large = CALIBRATION_ELEMENTS
         t_small, nlp_small = _time_build(self, mesh, small)
@@ -704,6 +712,13 @@ class _Transcription:
             np.arange(1, N - 1 if all(pb._final_fixes(p) for p in plans) else N)
             for _, _, plans in pb._constraints
         ]
+        self.bounds = self._simple_bounds()
+        # grad_f, jac_g and hess_lag assembled from the blocks' (mapped build), else CasADi's
+        self.derivatives: dict[str, Any] = {}
+        self.x: Any = None  # the NLP's variables, parameters, cost and rows (CasADi)
+        self.p: Any = None
+        self.f: Any = None
+        self.g: Any = None
         self.mapped = False
         if len(set(mesh.degrees)) == 1:
             try:
@@ -727,7 +742,56 @@ class _Transcription:
         ubx[th0:] = pb.max_element_rotation
         phi0 = th0 + nth * self.n_th_cols
         lbx[phi0 : phi0 + nth] = ubx[phi0 : phi0 + nth] = 0.0
+        for i, (r, a, d) in self.bounds.items():
+            c, _, _ = pb._constraints[i]
+            idx = self._path_nodes[i] * ny + r
+            lo, hi = self._path_bounds(c, "inequality")
+            lo_y, hi_y = sorted(((lo - d) / a, (hi - d) / a))
+            lbx[idx], ubx[idx] = lo_y, hi_y
         self.lbx, self.ubx = lbx, ubx
+
+    def _simple_bounds(self) -> dict[int, tuple[int, float, float]]:
+        """The inequalities that bound one state variable, ``l ≤ a y_r + d ≤ u`` with
+        constants a ≠ 0 and d (a :class:`~gmuk.PlaneBound` along an axis, say): constraint
+        index → (r, a, d). They become bounds on the variables y_r at the path nodes rather
+        than rows of the NLP, as one would write them by hand: no rows, no slacks, no
+        derivatives to evaluate. Only where nothing else bounds y_r (the initial state and
+        given final entries are not path nodes; a second such inequality on the same y_r
+        keeps its rows)."""
+        import casadi as ca
+
+        pb = self.problem
+        y = ca.SX.sym("y", pb.n_y)
+        Rs = [ca.SX.sym("R", 3, 3) for _ in range(pb.n_th // 3)]
+        t = ca.SX.sym("t")
+        found: dict[int, tuple[int, float, float]] = {}
+        taken: set[int] = set()
+        for i, (c, kind, plans) in enumerate(pb._constraints):
+            if kind != "inequality" or self._path_nodes[i].size == 0:
+                continue
+            q, nu = pb._casadi_qv(plans, y, Rs)
+            try:
+                h = parts.inequality_value(c, q, nu, t)
+            except DefinitionError:
+                continue  # needs a numeric time: checked and reported with the rows
+            others = ca.vertcat(t, *[ca.vec(R) for R in Rs])
+            if ca.depends_on(h, others):
+                continue
+            J = ca.jacobian(h, y)
+            if J.nnz() != 1 or ca.depends_on(J, y):
+                continue
+            r = int(J.sparsity().get_col()[0])
+            a = float(ca.evalf(J)[0, r])
+            d = float(ca.evalf(ca.substitute(h, y, ca.DM.zeros(pb.n_y))))
+            if not (np.isfinite(a) and np.isfinite(d)) or a == 0.0 or r in taken:
+                continue
+            if any(r == f for f in pb._final_y) and self._path_nodes[i][-1] == (
+                self.mesh.n_nodes - 1
+            ):
+                continue  # a given final value: keep the row, whose check reports a conflict
+            taken.add(r)
+            found[i] = (r, a, d)
+        return found
 
     def _path_bounds(self, c: Any, kind: str) -> tuple[float, float]:
         if kind != "inequality":
@@ -739,10 +803,15 @@ class _Transcription:
     def _node_terms(self, t: Any, y: Any, u: Any, Rs: Sequence[Any]) -> tuple[Any, list[Any], Any]:
         """F, the path-constraint values (one column per constraint) and the running cost
         at one node, for symbolic or numeric t."""
+        import casadi as ca
+
         pb = self.problem
         F = pb._rhs(t, y, u, Rs)
         values = []
-        for c, kind, plans in pb._constraints:
+        for i, (c, kind, plans) in enumerate(pb._constraints):
+            if i in self.bounds:
+                values.append(ca.DM(0, 1))
+                continue
             q, nu = pb._casadi_qv(plans, y, Rs)
             if kind == "inequality":
                 values.append(parts.inequality_value(c, q, nu, t))
@@ -811,49 +880,136 @@ class _Transcription:
         return X, P, Y, U, TH, PHI, RBAR
 
     def _build_mapped(self) -> None:
-        """One CasADi Function per element, with the node times as a symbolic input, mapped
-        over the elements: CasADi differentiates one element, not every node's copy, so the
-        cost of building the NLP hardly grows with the mesh."""
+        """The NLP as blocks (:mod:`gmuk.optimize._blocks`): one SX function of an element
+        (its collocation residuals, path-constraint values and cost), one of the attitude
+        continuity between two elements and one of the final attitude, each mapped over its
+        instances with the node times as an input. CasADi differentiates one element, not
+        every node's copy, so the cost of building the NLP hardly grows with the mesh, and
+        the NLP's derivatives are the blocks' own, summed."""
         import casadi as ca
 
         pb, mesh = self.problem, self.mesh
-        K, p = mesh.n_elements, mesh.degrees[0]
+        K, p, N = mesh.n_elements, mesh.degrees[0], mesh.n_nodes
         ny, nu_, nth, nr = pb.n_y, pb.n_u, pb.n_th, pb.n_th // 3
-        sym = [
-            ca.SX.sym("Rbar", 3, 3 * nr),
-            ca.SX.sym("phi", nth),
-            ca.SX.sym("y", ny, p + 1),
-            ca.SX.sym("u", nu_, p + 1),
-            ca.SX.sym("theta", nth, p),
-            ca.SX.sym("t", p + 1),
-        ]
-        R_start, R_end, res, cost, path = self._element(
-            p, sym[0], sym[1], sym[2], sym[3], sym[4], [sym[5][j] for j in range(p + 1)]
+        # the element's inputs: w = (φ, y₀, Y, u₀, U, Θ) are NLP variables, a = (R̄, t) not
+        w = ca.SX.sym("w", nth + ny * (p + 1) + nu_ * (p + 1) + nth * p)
+        a = ca.SX.sym("a", 9 * nr + p + 1)
+        cut = np.cumsum([0, nth, ny * (p + 1), nu_ * (p + 1), nth * p])
+        phi = w[cut[0] : cut[1]]
+        Yk = ca.reshape(w[cut[1] : cut[2]], ny, p + 1)
+        Uk = ca.reshape(w[cut[2] : cut[3]], nu_, p + 1)
+        THk = ca.reshape(w[cut[3] : cut[4]], nth, p)
+        Rbar = ca.reshape(a[: 9 * nr], 3, 3 * nr)
+        _, _, res, cost, path = self._element(
+            p, Rbar, phi, Yk, Uk, THk, [a[9 * nr + j] for j in range(p + 1)]
         )
-        fn = ca.Function("element", sym, [R_start, R_end, res, cost, *path])
+        rows_of = [i for i in range(len(pb._constraints)) if i not in self.bounds]
+        element = ca.Function(
+            "element", [w, a], [ca.vertcat(res, *[path[i] for i in rows_of]), cost]
+        )
         # float() or math.* on a symbol gives NaN silently (CasADi's SX.__float__): a part
         # that needs a numeric time shows it here, at the start, and goes node by node
-        _x0, p0 = self._sample_point()
-        Ys = np.repeat(self.problem.y0[:, None], p + 1, axis=1)
-        sample = fn(
-            p0[: 9 * nr].reshape(3, -1, order="F"),
-            np.zeros(nth),
-            Ys,
-            np.zeros((nu_, p + 1)),
-            np.zeros((nth, p)),
-            self.times[: p + 1],
+        x0, p0 = self._sample_point()
+        w0 = np.concatenate(
+            [np.zeros(nth), x0[: ny * (p + 1)], np.zeros(nu_ * (p + 1)), np.zeros(nth * p)]
         )
-        if not all(np.all(np.isfinite(np.asarray(v))) for v in sample):
+        a0 = np.concatenate([p0[: 9 * nr], self.times[: p + 1]])
+        if not all(np.all(np.isfinite(np.asarray(v))) for v in element(w0, a0)):
             raise DefinitionError("a part is not finite with a symbolic time")
         self.budget.check("transcribing")
-        X, P, Y, U, TH, PHI, RBAR = self._symbols(ca.MX)
-        idx = [k * p + j for k in range(K) for j in range(p + 1)]
-        T = ca.DM(np.asarray(self.times)[idx].reshape(K, p + 1).T)
-        out = fn.map(K)(RBAR, PHI, Y[:, idx], U[:, idx], TH, T)
-        self.budget.check("transcribing")
-        self._assemble(
-            X, P, U, out[0], out[1], ca.vec(out[2]), out[3], [ca.vec(o) for o in out[4:]]
+
+        # where each element's w sits in x (x = vec(Y), vec(U), vec(Θ), vec(Φ))
+        o1, o2 = ny * N, (ny + nu_) * N
+        o3 = o2 + nth * self.n_th_cols
+        nodes = np.arange(K)[:, None] * p + np.arange(p + 1)[None, :]  # (K, p + 1)
+
+        def entries(base: int, size: int, columns: np.ndarray) -> np.ndarray:
+            return (base + columns[..., None] * size + np.arange(size)).reshape(len(columns), -1)
+
+        cols_th = np.arange(K)[:, None] * p + np.arange(p)[None, :]
+        w_index = np.hstack(
+            [
+                entries(o3, nth, np.arange(K)[:, None]),
+                entries(0, ny, nodes),
+                entries(o1, nu_, nodes),
+                entries(o2, nth, cols_th),
+            ]
         )
+        P = ca.MX.sym("p", 9 * nr * K)
+        T = ca.DM(np.asarray(self.times)[nodes].T)
+        a_el = ca.vertcat(ca.reshape(P, 9 * nr, K), T)
+
+        # the rows: collocation residuals, continuity, each path constraint's, final attitude
+        n_res = int(res.shape[0])
+        sizes = [int(path[i].shape[0]) // p for i in range(len(pb._constraints))]
+        n_cont = 3 * nr * (K - 1) if nr else 0
+        n_final = 3 * sum(1 for q in pb._plans if q.rigid and q.body.name in pb._final_R)
+        starts = self._row_layout(K * n_res, n_cont, sizes, n_final)
+        el_rows = [np.arange(K)[:, None] * n_res + np.arange(n_res)[None, :]]
+        for i in rows_of:
+            s, r0 = sizes[i], starts[i]
+            # node k p + j (j = 1 … p) is path row r0 + (k p + j − 1) s + component, if kept
+            n = (nodes[:, 1:] - 1)[:, :, None] * s + np.arange(s)[None, None, :]
+            n = n.reshape(K, -1)
+            kept = self._path_nodes[i].size * s
+            el_rows.append(np.where((n < kept) & (r0 >= 0), r0 + n, -1))
+        blocks = [_blocks.Block(element, w_index, a_el, np.hstack(el_rows))]
+
+        if nr:
+            # continuity between elements k and k + 1, and the final attitude: functions of
+            # (φ_k, θ_k at its last node, φ_k+1) and of (φ_K, θ_K at its last node)
+            phi_a, th_a, phi_b = (ca.SX.sym(n, nth) for n in ("phi_a", "theta_a", "phi_b"))
+            Ra, Rb = ca.SX.sym("Ra", 9 * nr), ca.SX.sym("Rb", 9 * nr)
+
+            def start(R: Any, ph: Any) -> list[Any]:
+                Rm = ca.reshape(R, 3, 3 * nr)
+                return [
+                    Rm[:, 3 * b : 3 * b + 3] @ _so3.exp_casadi(ph[3 * b : 3 * b + 3])
+                    for b in range(nr)
+                ]
+
+            end_a = pb._attitudes(start(Ra, phi_a), th_a)
+            start_b = start(Rb, phi_b)
+            last = entries(o2, nth, cols_th[:, -1:])  # θ at each element's last node
+            phis = entries(o3, nth, np.arange(K)[:, None])
+            Rbars = ca.reshape(P, 9 * nr, K)
+            if K > 1:
+                cont = ca.Function(
+                    "continuity",
+                    [ca.vertcat(phi_a, th_a, phi_b), ca.vertcat(Ra, Rb)],
+                    [
+                        ca.vertcat(*[_skew_vee(start_b[b].T @ end_a[b]) for b in range(nr)]),
+                        ca.SX(1, 1),
+                    ],
+                )
+                blocks.append(
+                    _blocks.Block(
+                        cont,
+                        np.hstack([phis[:-1], last[:-1], phis[1:]]),
+                        ca.vertcat(Rbars[:, :-1], Rbars[:, 1:]),
+                        K * n_res + np.arange(n_cont).reshape(K - 1, 3 * nr),
+                    )
+                )
+            if n_final:
+                final = ca.Function(
+                    "final_attitude",
+                    [ca.vertcat(phi_a, th_a), Ra],
+                    [self._final_attitude_rows(end_a), ca.SX(1, 1)],
+                )
+                blocks.append(
+                    _blocks.Block(
+                        final,
+                        np.hstack([phis[-1:], last[-1:]]),
+                        Rbars[:, -1],
+                        (starts[-1] + np.arange(n_final))[None, :],
+                    )
+                )
+        X = ca.MX.sym("x", self.n_x)
+        self.budget.check("transcribing")
+        self.f, self.g, self.derivatives = _blocks.derivative_functions(
+            blocks, X, P, int(self.lbg.size)
+        )
+        self.x, self.p = X, P
 
     def _build_unrolled(self) -> None:
         """One expression per element, each part called with the nodes' numeric times."""
@@ -883,7 +1039,6 @@ class _Transcription:
         self._assemble(
             X,
             P,
-            U,
             ca.horzcat(*[o[0] for o in outs]),
             ca.horzcat(*[o[1] for o in outs]),
             ca.vertcat(*[o[2] for o in outs]),
@@ -895,7 +1050,6 @@ class _Transcription:
         self,
         X: Any,
         P: Any,
-        U: Any,
         R_start: Any,
         R_end: Any,
         dyn: Any,
@@ -919,35 +1073,50 @@ class _Transcription:
             g_blocks.append(
                 ca.vec(cont.map(K - 1)(R_start[:, 3 * nr :], R_end[:, : 3 * nr * (K - 1)]))
             )
-        n_eq = sum(b.shape[0] for b in g_blocks)
-        lbg, ubg = [0.0] * n_eq, [0.0] * n_eq
-        self.path_rows: list[tuple[Any, str, np.ndarray, int, int]] = []
-        row = n_eq
-        for (c, kind, _), nodes, values in zip(
-            pb._constraints, self._path_nodes, path, strict=True
-        ):
-            if nodes.size == 0:
-                continue
-            s = values.shape[0] // (self.mesh.n_nodes - 1)
-            block = values[: s * nodes.size]
-            lo, hi = self._path_bounds(c, kind)
-            lbg += [lo] * block.shape[0]
-            ubg += [hi] * block.shape[0]
-            g_blocks.append(block)
-            self.path_rows.append((c, kind, nodes, row, s))
-            row += block.shape[0]
         R_last = R_end[:, R_end.shape[1] - 3 * nr :]
         att = self._final_attitude_rows([R_last[:, 3 * b : 3 * b + 3] for b in range(nr)])
-        lbg += [0.0] * att.shape[0]
-        ubg += [0.0] * att.shape[0]
-        self.x: Any = X
-        self.p: Any = P
+        sizes = [v.shape[0] // (self.mesh.n_nodes - 1) for v in path]
+        n_eq = sum(b.shape[0] for b in g_blocks)
+        starts = self._row_layout(dyn.shape[0], n_eq - dyn.shape[0], sizes, att.shape[0])
+        for i, (values, r0) in enumerate(zip(path, starts, strict=False)):
+            if r0 >= 0:
+                g_blocks.append(values[: sizes[i] * self._path_nodes[i].size])
+        self.x, self.p = X, P
         self.g = ca.vertcat(*g_blocks, att)
-        if pb.cost is None:  # quadratic in U: one expression, outside the elements
-            self.f = ca.sum2(ca.sum1(U * (_dm(pb._M_inv) @ U)) * _dm(self.W).T)
-        else:
-            self.f = ca.sum2(costs)
+        self.f = ca.sum2(costs)
+
+    def _row_layout(self, n_dyn: int, n_cont: int, sizes: list[int], n_final: int) -> list[int]:
+        """Lay out the rows of g: the collocation residuals (``n_dyn``), the attitude
+        continuity (``n_cont``), each path constraint's values at its nodes (``sizes``: its
+        values per node) and the final attitudes (``n_final``). Sets ``lbg``, ``ubg`` and
+        ``path_rows``; returns each constraint's first row (−1 for one without rows) and,
+        last, the first final-attitude row."""
+        pb = self.problem
+        lbg, ubg = [0.0] * (n_dyn + n_cont), [0.0] * (n_dyn + n_cont)
+        # (constraint, kind, nodes, first row, values per node); for an inequality imposed
+        # as variable bounds: (constraint, "bound", nodes, its index in _constraints, 1)
+        self.path_rows: list[tuple[Any, str, np.ndarray, int, int]] = []
+        starts = []
+        for i, ((c, kind, _), nodes, s) in enumerate(
+            zip(pb._constraints, self._path_nodes, sizes, strict=True)
+        ):
+            if i in self.bounds:  # variable bounds (_simple_bounds), no rows
+                self.path_rows.append((c, "bound", nodes, i, 1))
+                starts.append(-1)
+                continue
+            if nodes.size == 0:
+                starts.append(-1)
+                continue
+            lo, hi = self._path_bounds(c, kind)
+            starts.append(len(lbg))
+            self.path_rows.append((c, kind, nodes, len(lbg), s))
+            lbg += [lo] * (s * nodes.size)
+            ubg += [hi] * (s * nodes.size)
+        starts.append(len(lbg))
+        lbg += [0.0] * n_final
+        ubg += [0.0] * n_final
         self.lbg, self.ubg = np.array(lbg), np.array(ubg)
+        return starts
 
     def _sample_point(self) -> tuple[FloatArray, FloatArray]:
         """x with the initial state at every node and zero controls and charts, and p with
@@ -1124,6 +1293,7 @@ class _Transcription:
             opts["ipopt.output_file"] = log_path
             opts["ipopt.file_print_level"] = 5
         opts.update(ipopt_options)
+        opts.update(self.derivatives)
         nlp = {"x": self.x, "p": self.p, "f": self.f, "g": self.g}
         try:
             solver = ca.nlpsol("gmuk", "ipopt", nlp, opts)
@@ -1164,6 +1334,38 @@ class _Transcription:
         return self._result(
             x, pbar, lam_g, lam_x, gval, float(out["f"]), stats, history, text, timings, viol
         )
+
+    def path_values(
+        self, x: FloatArray, gval: FloatArray, lam_g: FloatArray, lam_x: FloatArray
+    ) -> list[tuple[Any, str, np.ndarray, FloatArray, FloatArray, float, float]]:
+        """Per path constraint: (constraint, "inequality" or the equality's kind, its nodes,
+        its values (n_nodes, m), the NLP's multipliers of them (n_nodes, m, not divided by
+        the quadrature weights), lower and upper bound). An inequality imposed as variable
+        bounds has the value a y_r + d and the multiplier λ_x / a of the row it replaces."""
+        out = []
+        ny = self.problem.n_y
+        for c, kind, nodes, r0, m in self.path_rows:
+            if kind == "bound":
+                r, a, d = self.bounds[r0]
+                idx = nodes * ny + r
+                lo, hi = self._path_bounds(c, "inequality")
+                vals = (a * x[idx] + d)[:, None]
+                out.append((c, "inequality", nodes, vals, (lam_x[idx] / a)[:, None], lo, hi))
+                continue
+            n = nodes.size
+            rows = np.arange(r0, r0 + n * m)
+            out.append(
+                (
+                    c,
+                    kind,
+                    nodes,
+                    gval[rows].reshape(n, m),
+                    lam_g[rows].reshape(n, m),
+                    float(self.lbg[rows[0]]),
+                    float(self.ubg[rows[0]]),
+                )
+            )
+        return out
 
     def _unpack(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         pb, N, K = self.problem, self.mesh.n_nodes, self.mesh.n_elements
@@ -1215,18 +1417,15 @@ class _Transcription:
         Y, U, TH, PHI = self._unpack(x)
         R, starts = self._attitudes_numeric(TH, PHI, pbar)
         paths = {}
-        for c, kind, nodes, r0, m in self.path_rows:
-            n = nodes.size
-            rows = np.arange(r0, r0 + n * m)
-            vals = gval[rows].reshape(n, m)
-            lam = lam_g[rows].reshape(n, m) / self.W[nodes][:, None]
+        for c, kind, nodes, vals, lam_raw, lo, hi in self.path_values(x, gval, lam_g, lam_x):
+            lam = lam_raw / self.W[nodes][:, None]
             paths[c.name] = PathConstraintResult(
                 name=c.name,
                 kind=kind,
                 t=self.times[nodes],
                 value=vals[:, 0] if kind == "inequality" else vals,
-                lower=float(self.lbg[rows[0]]) if kind == "inequality" else 0.0,
-                upper=float(self.ubg[rows[0]]) if kind == "inequality" else 0.0,
+                lower=lo if kind == "inequality" else 0.0,
+                upper=hi if kind == "inequality" else 0.0,
                 multiplier=lam[:, 0] if kind == "inequality" else lam,
                 unit=getattr(c, "unit", "") if kind == "inequality" else "",
                 cost_unit="N²·s/kg" if pb.cost is None else "cost",
@@ -1388,18 +1587,18 @@ class _KKTEvaluator:
         # complementarity of the inequality rows: λ times the distance to the bound it pushes
         comp = 0.0
         dual = 0.0
-        for _c, kind, nodes, r0, _m in tr.path_rows:
+        paths = tr.path_values(self.x, gval, self.lam_g, self.lam_x)
+        for _c, kind, _nodes, vals, lam_n, lower, upper in paths:
             if kind != "inequality":
                 continue
-            rows = np.arange(r0, r0 + nodes.size)
-            lam_i, g_i = self.lam_g[rows], gval[rows]
-            up = np.where(np.isfinite(tr.ubg[rows]), tr.ubg[rows] - g_i, np.inf)
-            lo = np.where(np.isfinite(tr.lbg[rows]), g_i - tr.lbg[rows], np.inf)
+            lam_i, g_i = lam_n[:, 0], vals[:, 0]
+            up = upper - g_i if np.isfinite(upper) else np.full_like(g_i, np.inf)
+            lo = g_i - lower if np.isfinite(lower) else np.full_like(g_i, np.inf)
             dist = np.where(lam_i > 0, up, lo)
             dist = np.where(np.isfinite(dist), dist, 0.0)
             comp = max(comp, float(np.abs(lam_i * dist).max(initial=0.0)))
             # a multiplier pushing from a side with no bound is dual-infeasible
-            wrong = np.where(lam_i > 0, ~np.isfinite(tr.ubg[rows]), ~np.isfinite(tr.lbg[rows]))
+            wrong = np.where(lam_i > 0, not np.isfinite(upper), not np.isfinite(lower))
             dual = max(dual, float(np.abs(lam_i[wrong]).max(initial=0.0)))
         return {
             "stationarity": float(np.abs(gL).max(initial=0.0)),
@@ -1499,6 +1698,7 @@ def _time_build(problem: OptimalControlProblem, mesh: Mesh, n: int) -> tuple[flo
         "ipopt.print_level": 0,
         "ipopt.sb": "yes",
         "ipopt.max_iter": 0,
+        **tr.derivatives,
     }
     solver = ca.nlpsol("timing", "ipopt", {"x": tr.x, "p": tr.p, "f": tr.f, "g": tr.g}, opts)
     solver(x0=np.clip(x0, tr.lbx, tr.ubx), p=p, lbx=tr.lbx, ubx=tr.ubx, lbg=tr.lbg, ubg=tr.ubg)
