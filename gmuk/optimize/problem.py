@@ -137,6 +137,19 @@ class OptimalControlProblem:
         element and φ, an element's start against its reference attitude from the guess
         (≤ 1.5; default 1.5). Refine the mesh if a body turns faster than that per element,
         and start from a closer guess (``guess=``) if the optimum turns that far from it.
+    control_bounds : mapping, optional
+        Body name → ``(lower, upper)``: bounds on that body's control at every node, each a
+        number or one per component (a point mass's f_N, N; a rigid body's [L; f] in the
+        body frame, N·m and N); ``None`` or ±inf for no bound on a side. Default: none.
+    free_final_time : (float, float), optional
+        ``(t_min, t_max)`` (s): the final time is an unknown in this interval, ``t_final``
+        its starting guess (``t_min ≤ t_final ≤ t_max``). The mesh is laid on
+        [t0, t_final] and scaled with the final time (its elements keep their proportions).
+        Default: the final time is ``t_final``.
+    time_cost : float
+        Weight (cost units per s, ≥ 0) of the elapsed time ``t_f − t0`` added to the cost;
+        with ``cost=lambda t, q, nu, u: 0`` and bounded controls, a minimum-time problem.
+        Needs ``free_final_time``. Default 0.
 
     Raises
     ------
@@ -159,6 +172,9 @@ class OptimalControlProblem:
         final: State | Mapping[str, Any] | None = None,
         cost: CostFunction | None = None,
         max_element_rotation: float = 1.5,
+        control_bounds: Mapping[str, Any] | None = None,
+        free_final_time: tuple[float, float] | None = None,
+        time_cost: float = 0.0,
     ) -> None:
         from gmuk.engine.system import System
 
@@ -213,9 +229,84 @@ class OptimalControlProblem:
             self._M_inv[p.u : p.u + d, p.u : p.u + d] = Minv
         self.y0, self.R0 = self._initial_values(initial)
         self._final_y, self._final_R = self._final_values(final)
+        self.u_lower, self.u_upper = self._control_bounds(control_bounds)
+        self.tf_bounds = self._free_final_time(free_final_time)
+        self.time_cost = real_number(time_cost, "time_cost")
+        if self.time_cost < 0.0:
+            raise DefinitionError(f"time_cost must be ≥ 0; got {self.time_cost}")
+        if self.time_cost and self.tf_bounds is None:
+            raise DefinitionError(
+                "time_cost weighs the final time, which is fixed: give free_final_time="
+                "(t_min, t_max) too"
+            )
         self._check_boundaries()
 
     # ------------------------------------------------------------------ set-up
+    def _control_bounds(self, bounds: Any) -> tuple[FloatArray, FloatArray]:
+        """Per control component: lower and upper bound (−inf/inf where none)."""
+        lower, upper = np.full(self.n_u, -np.inf), np.full(self.n_u, np.inf)
+        if bounds is None:
+            return lower, upper
+        if not isinstance(bounds, Mapping):
+            raise DefinitionError(
+                "control_bounds must map body names to (lower, upper), e.g. "
+                f"{{'sat': (-0.1, 0.1)}}; got {type(bounds).__name__}"
+            )
+        for name, pair in bounds.items():
+            plan = self._by_name.get(name) if isinstance(name, str) else None
+            if plan is None:
+                raise DefinitionError(
+                    f"control_bounds: {name!r} is not a body of the problem; its bodies are "
+                    f"{sorted(self._by_name)}"
+                )
+            if not isinstance(pair, (tuple, list)) or len(pair) != 2:
+                raise DefinitionError(
+                    f"control_bounds[{name!r}] must be (lower, upper); got {pair!r:.60}"
+                )
+            d = plan.body.dof
+            sides = []
+            for side, value, default in (("lower", pair[0], -np.inf), ("upper", pair[1], np.inf)):
+                try:
+                    v = np.array(
+                        [default if e is None else e for e in value]
+                        if isinstance(value, (list, tuple))
+                        else (default if value is None else value),
+                        dtype=float,
+                    )
+                except (TypeError, ValueError):
+                    v = np.full(0, np.nan)
+                if v.ndim == 0:
+                    v = np.full(d, float(v))
+                if v.shape != (d,) or np.isnan(v).any():
+                    raise DefinitionError(
+                        f"control_bounds[{name!r}] {side}: a number or {d} numbers (not NaN) "
+                        f"for its {d} control components; got {value!r:.60}"
+                    )
+                sides.append(v)
+            if np.any(sides[0] > sides[1]):
+                raise DefinitionError(
+                    f"control_bounds[{name!r}]: lower {sides[0]} exceeds upper {sides[1]}"
+                )
+            lower[plan.u : plan.u + d], upper[plan.u : plan.u + d] = sides
+        return lower, upper
+
+    def _free_final_time(self, bounds: Any) -> tuple[float, float] | None:
+        """(t_min, t_max) of a free final time, checked against t0 and the guess t_final."""
+        if bounds is None:
+            return None
+        if not isinstance(bounds, (tuple, list)) or len(bounds) != 2:
+            raise DefinitionError(
+                f"free_final_time must be (t_min, t_max) in s; got {bounds!r:.60}"
+            )
+        lo = real_number(bounds[0], "free_final_time t_min (s)")
+        hi = real_number(bounds[1], "free_final_time t_max (s)")
+        if not self.t0 < lo <= self.tf <= hi:
+            raise DefinitionError(
+                f"free_final_time: need t0 ({self.t0:g}) < t_min ≤ t_final ≤ t_max; got "
+                f"t_min {lo:g}, t_final {self.tf:g} (the guess), t_max {hi:g}"
+            )
+        return lo, hi
+
     def _force_plan(self) -> list[tuple[Any, list[_BodyPlan]]]:
         out = []
         for f in self.system.forces:
@@ -541,6 +632,8 @@ class OptimalControlProblem:
             )
         lo = self.t0 + 1e-9 * max(1.0, abs(self.t0))
         hi = self.tf - 1e-9 * max(1.0, abs(self.tf))
+        if self.tf_bounds is not None:  # read at the same fractions of its own span
+            hi = guess.mesh.t0
         if guess.mesh.t0 > lo or guess.mesh.tf < hi:
             raise DefinitionError(
                 f"guess spans [{guess.mesh.t0:g}, {guess.mesh.tf:g}] s; it must cover the "
@@ -635,6 +728,11 @@ class OptimalControlProblem:
         OptimalControlResult
             The last solve's, with ``refinement`` the list of :class:`RefinementStep`.
         """
+        if self.tf_bounds is not None:
+            raise DefinitionError(
+                "solve_adaptive refines a mesh of fixed span; with free_final_time, refine by "
+                "hand: solve on a finer mesh with guess= the previous result"
+            )
         tol = real_number(tol, "tol", positive=True)
         rounds = strict_integer(max_rounds, "max_rounds", minimum=1)
         most = strict_integer(max_elements, "max_elements", minimum=1)
@@ -705,7 +803,9 @@ class _Transcription:
     def _build(self) -> None:
         pb, mesh = self.problem, self.mesh
         N, K, ny, nu_, nth = mesh.n_nodes, mesh.n_elements, pb.n_y, pb.n_u, pb.n_th
-        self.n_x = (ny + nu_) * N + nth * self.n_th_cols + nth * K
+        # x = vec(Y), vec(U), vec(Θ), vec(Φ)[, t_f when it is free]
+        self.free = pb.tf_bounds is not None
+        self.n_x = (ny + nu_) * N + nth * self.n_th_cols + nth * K + int(self.free)
         # path constraints at nodes 1 … N−1 (the last skipped where the final state fixes
         # the constraint's bodies: it was checked before solving)
         self._path_nodes = [
@@ -742,6 +842,11 @@ class _Transcription:
         ubx[th0:] = pb.max_element_rotation
         phi0 = th0 + nth * self.n_th_cols
         lbx[phi0 : phi0 + nth] = ubx[phi0 : phi0 + nth] = 0.0
+        lbx[ny * N : th0] = np.tile(pb.u_lower, N)
+        ubx[ny * N : th0] = np.tile(pb.u_upper, N)
+        if self.free:
+            assert pb.tf_bounds is not None
+            lbx[-1], ubx[-1] = pb.tf_bounds
         for i, (r, a, d) in self.bounds.items():
             c, _, _ = pb._constraints[i]
             idx = self._path_nodes[i] * ny + r
@@ -875,7 +980,7 @@ class _Transcription:
         Y = ca.reshape(X[:o1], ny, N)
         U = ca.reshape(X[o1:o2], nu_, N)
         TH = ca.reshape(X[o2:o3], nth, self.n_th_cols)
-        PHI = ca.reshape(X[o3:], nth, K)
+        PHI = ca.reshape(X[o3 : o3 + nth * K], nth, K)
         RBAR = ca.reshape(P, 3, 3 * (nth // 3) * K)
         return X, P, Y, U, TH, PHI, RBAR
 
@@ -891,8 +996,11 @@ class _Transcription:
         pb, mesh = self.problem, self.mesh
         K, p, N = mesh.n_elements, mesh.degrees[0], mesh.n_nodes
         ny, nu_, nth, nr = pb.n_y, pb.n_u, pb.n_th, pb.n_th // 3
-        # the element's inputs: w = (φ, y₀, Y, u₀, U, Θ) are NLP variables, a = (R̄, t) not
-        w = ca.SX.sym("w", nth + ny * (p + 1) + nu_ * (p + 1) + nth * p)
+        # the element's inputs: w = (φ, y₀, Y, u₀, U, Θ[, t_f]) are NLP variables, a = (R̄,
+        # the node times) not; with a free final time a holds the nodes' fractions s of the
+        # span instead, and the times are t0 + (t_f − t0) s
+        free = int(self.free)
+        w = ca.SX.sym("w", nth + ny * (p + 1) + nu_ * (p + 1) + nth * p + free)
         a = ca.SX.sym("a", 9 * nr + p + 1)
         cut = np.cumsum([0, nth, ny * (p + 1), nu_ * (p + 1), nth * p])
         phi = w[cut[0] : cut[1]]
@@ -900,9 +1008,10 @@ class _Transcription:
         Uk = ca.reshape(w[cut[2] : cut[3]], nu_, p + 1)
         THk = ca.reshape(w[cut[3] : cut[4]], nth, p)
         Rbar = ca.reshape(a[: 9 * nr], 3, 3 * nr)
-        _, _, res, cost, path = self._element(
-            p, Rbar, phi, Yk, Uk, THk, [a[9 * nr + j] for j in range(p + 1)]
-        )
+        node = [a[9 * nr + j] for j in range(p + 1)]
+        if self.free:
+            node = [pb.t0 + (w[-1] - pb.t0) * sj for sj in node]
+        _, _, res, cost, path = self._element(p, Rbar, phi, Yk, Uk, THk, node)
         rows_of = [i for i in range(len(pb._constraints)) if i not in self.bounds]
         element = ca.Function(
             "element", [w, a], [ca.vertcat(res, *[path[i] for i in rows_of]), cost]
@@ -912,8 +1021,9 @@ class _Transcription:
         x0, p0 = self._sample_point()
         w0 = np.concatenate(
             [np.zeros(nth), x0[: ny * (p + 1)], np.zeros(nu_ * (p + 1)), np.zeros(nth * p)]
+            + ([[pb.tf]] if self.free else [])
         )
-        a0 = np.concatenate([p0[: 9 * nr], self.times[: p + 1]])
+        a0 = np.concatenate([p0[: 9 * nr], self._node_inputs()[: p + 1]])
         if not all(np.all(np.isfinite(np.asarray(v))) for v in element(w0, a0)):
             raise DefinitionError("a part is not finite with a symbolic time")
         self.budget.check("transcribing")
@@ -934,9 +1044,10 @@ class _Transcription:
                 entries(o1, nu_, nodes),
                 entries(o2, nth, cols_th),
             ]
+            + ([np.full((K, 1), self.n_x - 1)] if self.free else [])
         )
         P = ca.MX.sym("p", 9 * nr * K)
-        T = ca.DM(np.asarray(self.times)[nodes].T)
+        T = ca.DM(self._node_inputs()[nodes].T)
         a_el = ca.vertcat(ca.reshape(P, 9 * nr, K), T)
 
         # the rows: collocation residuals, continuity, each path constraint's, final attitude
@@ -1004,6 +1115,18 @@ class _Transcription:
                         (starts[-1] + np.arange(n_final))[None, :],
                     )
                 )
+        if pb.time_cost:  # time_cost (t_f − t0): a block of its own, no rows
+            tf_sym = ca.SX.sym("tf")
+            elapsed = ca.Function(
+                "elapsed_time",
+                [tf_sym, ca.SX.sym("a", 0)],
+                [ca.SX(0, 1), pb.time_cost * (tf_sym - pb.t0)],
+            )
+            blocks.append(
+                _blocks.Block(
+                    elapsed, np.array([[self.n_x - 1]]), ca.DM(0, 1), np.zeros((1, 0), dtype=int)
+                )
+            )
         X = ca.MX.sym("x", self.n_x)
         self.budget.check("transcribing")
         self.f, self.g, self.derivatives = _blocks.derivative_functions(
@@ -1031,7 +1154,10 @@ class _Transcription:
                     Y[:, i0 : i0 + p + 1],
                     U[:, i0 : i0 + p + 1],
                     TH[:, col : col + p],
-                    [float(t) for t in self.times[i0 : i0 + p + 1]],
+                    [
+                        pb.t0 + (X[-1] - pb.t0) * float(s) if self.free else float(s)
+                        for s in self._node_inputs()[i0 : i0 + p + 1]
+                    ],
                 )
             )
             col += p
@@ -1084,6 +1210,8 @@ class _Transcription:
         self.x, self.p = X, P
         self.g = ca.vertcat(*g_blocks, att)
         self.f = ca.sum2(costs)
+        if pb.time_cost:
+            self.f = self.f + pb.time_cost * (X[-1] - pb.t0)
 
     def _row_layout(self, n_dyn: int, n_cont: int, sizes: list[int], n_final: int) -> list[int]:
         """Lay out the rows of g: the collocation residuals (``n_dyn``), the attitude
@@ -1118,12 +1246,20 @@ class _Transcription:
         self.lbg, self.ubg = np.array(lbg), np.array(ubg)
         return starts
 
+    def _node_inputs(self) -> FloatArray:
+        """The node times (s), or with a free final time their fractions of the span."""
+        if self.free:
+            return (self.times - self.problem.t0) / (self.problem.tf - self.problem.t0)
+        return np.asarray(self.times, dtype=float)
+
     def _sample_point(self) -> tuple[FloatArray, FloatArray]:
         """x with the initial state at every node and zero controls and charts, and p with
         the initial attitudes as every element's reference."""
         pb, mesh = self.problem, self.mesh
         x = np.zeros(self.n_x)
         x[: pb.n_y * mesh.n_nodes] = np.tile(pb.y0, mesh.n_nodes)
+        if self.free:
+            x[-1] = pb.tf
         Rbar = np.tile(np.array(pb.R0).reshape(1, -1, 3, 3), (mesh.n_elements, 1, 1, 1))
         p = np.transpose(Rbar, (2, 0, 1, 3)).reshape(3, -1).reshape(-1, order="F")
         return x, p
@@ -1206,9 +1342,11 @@ class _Transcription:
         nr = pb.n_th // 3
         s = (t - pb.t0) / (pb.tf - pb.t0)
         if guess is not None:
-            Yg = guess.states_at(t)
-            Ug = guess.control(t)
-            Rg = guess.attitudes_at(t)
+            # with a free final time the guess is read at the same fraction of its span
+            tg = pb.t0 + s * (float(guess.t[-1]) - pb.t0) if self.free else t
+            Yg = guess.states_at(tg)
+            Ug = guess.control(tg)
+            Rg = guess.attitudes_at(tg)
         else:
             yf = pb.y0.copy()
             for r, v in pb._final_y.items():
@@ -1250,6 +1388,7 @@ class _Transcription:
                 Ug.reshape(-1),
                 TH.reshape(-1, order="F"),
                 np.zeros(pb.n_th * mesh.n_elements),
+                [pb.tf if guess is None else float(guess.t[-1])] if self.free else [],
             ]
         )
         # p = vec(R̄) with R̄ (3, 3 n_rigid K): element k, body b in columns 3(n_r k + b) …
@@ -1374,7 +1513,7 @@ class _Transcription:
         Y = x[:o1].reshape(N, ny)
         U = x[o1:o2].reshape(N, nu_)
         TH = x[o2:o3].reshape(self.n_th_cols, nth)
-        PHI = x[o3:].reshape(K, nth)
+        PHI = x[o3 : o3 + nth * K].reshape(K, nth)
         return Y, U, TH, PHI
 
     def _attitudes_numeric(
@@ -1416,13 +1555,18 @@ class _Transcription:
         pb, mesh = self.problem, self.mesh
         Y, U, TH, PHI = self._unpack(x)
         R, starts = self._attitudes_numeric(TH, PHI, pbar)
+        times, W = self.times, self.W
+        if self.free:  # the mesh scaled to the optimal final time
+            scale = (float(x[-1]) - pb.t0) / (pb.tf - pb.t0)
+            times, W = pb.t0 + (self.times - pb.t0) * scale, self.W * scale
+            mesh = Mesh(pb.t0 + (mesh.breaks - pb.t0) * scale, mesh.degrees, max_nodes=mesh.n_nodes)
         paths = {}
         for c, kind, nodes, vals, lam_raw, lo, hi in self.path_values(x, gval, lam_g, lam_x):
-            lam = lam_raw / self.W[nodes][:, None]
+            lam = lam_raw / W[nodes][:, None]
             paths[c.name] = PathConstraintResult(
                 name=c.name,
                 kind=kind,
-                t=self.times[nodes],
+                t=times[nodes],
                 value=vals[:, 0] if kind == "inequality" else vals,
                 lower=lo if kind == "inequality" else 0.0,
                 upper=hi if kind == "inequality" else 0.0,
@@ -1431,7 +1575,7 @@ class _Transcription:
                 cost_unit="N²·s/kg" if pb.cost is None else "cost",
             )
         return OptimalControlResult(
-            t=self.times.copy(),
+            t=np.array(times, dtype=float),
             mesh=mesh,
             body_names=tuple(p.body.name for p in pb._plans),
             body_kinds=tuple(str(p.body.kind) for p in pb._plans),
@@ -1453,6 +1597,7 @@ class _Transcription:
                 "constraint_violation": violation,
                 "n_variables": int(x.size),
                 "n_constraints": int(gval.size),
+                "t_final": float(times[-1]),
             },
             _kkt=_KKTEvaluator(self, x, pbar, lam_g, lam_x),
         )
