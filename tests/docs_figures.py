@@ -153,6 +153,30 @@ def _optimize_table() -> dict[str, Any]:
     return out
 
 
+def _between_nodes_run() -> dict[str, Any]:
+    """docs/optimize.rst's "Between the nodes": the bounded SMD's largest violation of
+    1 m ≤ x ≤ 2 m between the nodes on 150 uniform elements of degree 3, and adaptive
+    refinement with ``bound_tol = 1e-6`` m from 10 elements."""
+    from gmuk.optimize import Mesh, OptimalControlProblem
+    from gmuk.scenarios import smd
+
+    system, state = smd.build("smd-bi")
+    problem = OptimalControlProblem(system, state, 30.0)
+    out: dict[str, Any] = {}
+    uniform = problem.solve(Mesh.uniform(0.0, 30.0, 150, 3))
+    out["uniform_150/violation_m"] = uniform.violation_between_nodes()["x"]
+    refined = problem.solve_adaptive(
+        Mesh.uniform(0.0, 30.0, 10, 3), tol=1e-6, bound_tol=1e-6, max_rounds=12
+    )
+    steps = refined.refinement or []
+    out["refined/rounds"] = len(steps)
+    out["refined/elements"] = steps[-1].n_elements
+    out["refined/violation_m"] = refined.violation_between_nodes()["x"]
+    out["refined/objective"] = refined.objective
+    out["refined/first_violation_m"] = steps[0].max_bound_violation
+    return out
+
+
 def _thesis_nodes_run() -> dict[str, Any]:
     """smd-compare's SMD-BI on one element of degree 4 (the thesis's five nodes; the
     extremes of x between the nodes are ``x_direct_collocation_*``), and how far its
@@ -371,6 +395,9 @@ RUNS: dict[str, Run] = {
     ),
     "maintenance-slack-120": Run(
         "maintenance", {"slack_mass": "120", "compare": "false"}, seconds=90
+    ),
+    "optimize-between": Run(
+        "(docs/optimize.rst, between the nodes)", 3, function=_between_nodes_run
     ),
     "optimize-table": Run(
         "(benchmarks/bench_optimize.py --table)", seconds=25, function=_optimize_table
@@ -1206,6 +1233,18 @@ _add(
     ("m to 8.6 m", "x_direct_collocation_max_m", "m to {:.1f} m"),
     ("0.934 m and 1.5", "x_direct_min_on_grid_m", "{:.3f} m and 1.5"),
     ("and 1.5 m (``x_direct", "x_direct_max_on_grid_m", "and {:.1f} m (``x_direct"),
+)
+
+# docs/optimize.rst, between the nodes ----------------------------------------------------------
+_add(
+    OPT,
+    "optimize-between",
+    ("by 3.3e-3 m on 150", "uniform_150/violation_m", "by {:.1e} m on 150"),
+    ("(0.14 m on its first mesh)", "refined/first_violation_m", "({:.2f} m on its first mesh)"),
+    ("stop after 8 rounds", "refined/rounds", "stop after {} rounds"),
+    ("at 153 elements", "refined/elements", "at {} elements"),
+    ("violation 6.8e-7 m", "refined/violation_m", "violation {:.1e} m"),
+    ("objective 1581.6972", "refined/objective", "objective {:.4f}"),
 )
 
 # docs/optimize.rst (benchmarks/bench_optimize.py --table; its times are in TIMINGS) ----------

@@ -82,6 +82,10 @@ CALIBRATION_ELEMENTS = (16, 64)
 #: Factor on the build time extrapolated from the partial meshes (see above).
 BUILD_MARGIN = 1.5
 
+#: Points per element, equally spaced between its ends, at which the path inequalities are
+#: evaluated between the nodes (``OptimalControlResult.violation_between_nodes``).
+BETWEEN_NODE_SAMPLES = 20
+
 #: Meshes of one degree and at most this many elements are built without timing a part
 #: first: their build is one element's symbolic work and then, per element, only index
 #: arithmetic and sparse assembly (``_blocks``), small beside any budget (under a second at
@@ -696,10 +700,12 @@ class OptimalControlProblem:
         max_elements: int = 2000,
         n_elements: int = 20,
         degree: int = 3,
+        bound_tol: float | None = None,
         **options: Any,
     ) -> OptimalControlResult:
         """Solve, estimate each element's error, split the elements above ``tol`` and
-        solve again from the previous solution, until every element is below ``tol``.
+        solve again from the previous solution, until every element is below ``tol`` (and,
+        with ``bound_tol``, the path inequalities hold between the nodes to ``bound_tol``).
 
         The error estimate of element k is the collocation defect between the nodes:
         at 2p + 1 Gauss points inside the element the state polynomial
@@ -720,6 +726,10 @@ class OptimalControlProblem:
             ``refinement`` history says so).
         max_elements : int
             Stop refining before a mesh would exceed this many elements.
+        bound_tol : float, optional
+            Largest violation of a path inequality between the nodes (in its own unit:
+            :meth:`~gmuk.optimize.OptimalControlResult.violation_between_nodes`) to accept;
+            an element where it is larger is split in two at least. Default: not checked.
         options
             Passed to :meth:`solve`; ``max_cpu_time`` is the budget of each solve.
 
@@ -736,6 +746,7 @@ class OptimalControlProblem:
         tol = real_number(tol, "tol", positive=True)
         rounds = strict_integer(max_rounds, "max_rounds", minimum=1)
         most = strict_integer(max_elements, "max_elements", minimum=1)
+        b_tol = None if bound_tol is None else real_number(bound_tol, "bound_tol", positive=True)
         if mesh is None:
             mesh = Mesh.uniform(self.t0, self.tf, n_elements, degree)
         history: list[RefinementStep] = []
@@ -743,8 +754,12 @@ class OptimalControlProblem:
         result = None
         for rnd in range(rounds):
             result = self.solve(mesh, guess=guess, **options)
-            errors = _Transcription(self, mesh, build=False).element_errors(result)
+            tr = _Transcription(self, mesh, build=False)
+            errors = tr.element_errors(result)
             emax = float(errors.max())
+            violations = np.zeros(mesh.n_elements)
+            if b_tol is not None:
+                violations = tr.bound_violations(result)[0]
             history.append(
                 RefinementStep(
                     rnd,
@@ -754,11 +769,16 @@ class OptimalControlProblem:
                     emax,
                     result.iterations,
                     result.timings["total_s"],
+                    float(violations.max()) if b_tol is not None else float("nan"),
                 )
             )
-            if emax <= tol:
+            outside = violations > (b_tol if b_tol is not None else np.inf)
+            if emax <= tol and not outside.any():
                 break
-            counts = split_counts(errors, tol, mesh.degrees)
+            counts = [
+                max(c, 2 if out else 1)
+                for c, out in zip(split_counts(errors, tol, mesh.degrees), outside, strict=True)
+            ]
             if mesh.n_elements + sum(c - 1 for c in counts) > most:
                 break
             mesh, guess = mesh.split(counts), result
@@ -1600,7 +1620,39 @@ class _Transcription:
                 "t_final": float(times[-1]),
             },
             _kkt=_KKTEvaluator(self, x, pbar, lam_g, lam_x),
+            _between=lambda res: self.bound_violations(res)[1],
         )
+
+    # ------------------------------------------------------------------ between the nodes
+    def bound_violations(
+        self, result: OptimalControlResult, samples: int = BETWEEN_NODE_SAMPLES
+    ) -> tuple[FloatArray, dict[str, float]]:
+        """How far the path inequalities are violated between the nodes: per element of
+        ``result.mesh`` the largest violation of any of them (in each one's own unit), and
+        per inequality its largest. The state between the nodes is the result's
+        interpolant (:meth:`~gmuk.optimize.OptimalControlResult.states_at`,
+        :meth:`~gmuk.optimize.OptimalControlResult.attitudes_at`), evaluated at ``samples``
+        equally spaced points inside each element."""
+        pb, mesh = self.problem, result.mesh
+        K = mesh.n_elements
+        frac = np.arange(1, samples + 1) / (samples + 1)
+        breaks = np.asarray(mesh.breaks)
+        t = (breaks[:-1, None] + np.diff(breaks)[:, None] * frac[None, :]).reshape(-1)
+        Y = result.states_at(t)
+        R = result.attitudes_at(t)
+        per_element = np.zeros(K)
+        per_constraint: dict[str, float] = {}
+        for c, kind, plans in pb._constraints:
+            if kind != "inequality":
+                continue
+            worst = np.zeros(t.size)
+            for i in range(t.size):
+                q, nu = pb._body_qv(plans, Y[i], R[i])
+                h = float(np.asarray(c.value(q, nu, float(t[i])), dtype=float).reshape(-1)[0])
+                worst[i] = max(0.0, *(-bd.margin(h) for bd in c.bounds))
+            per_element = np.maximum(per_element, worst.reshape(K, samples).max(axis=1))
+            per_constraint[c.name] = float(worst.max(initial=0.0))
+        return per_element, per_constraint
 
     # ------------------------------------------------------------------ error estimate
     def element_errors(self, result: OptimalControlResult) -> FloatArray:

@@ -136,6 +136,8 @@ class RefinementStep:
     max_error: float
     iterations: int
     total_s: float
+    #: the largest path-inequality violation between the nodes (``bound_tol`` given), or nan
+    max_bound_violation: float = float("nan")
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,6 +206,9 @@ class OptimalControlResult:
     stats: dict[str, Any]
     _kkt: Callable[[], dict[str, float]] = field(repr=False)
     refinement: list[RefinementStep] | None = None
+    _between: Callable[[OptimalControlResult], dict[str, float]] | None = field(
+        default=None, repr=False
+    )
 
     def __repr__(self) -> str:
         return (
@@ -345,6 +350,17 @@ class OptimalControlResult:
             multiplier pushing from a side with no bound).
         """
         return self._kkt()
+
+    def violation_between_nodes(self) -> dict[str, float]:
+        """The largest violation of each path inequality between the nodes, in its own
+        unit (0 where it holds): the constraints hold at the nodes only, and the state's
+        interpolant (:meth:`states_at`, :meth:`attitudes_at`) can leave the bounds between
+        them. Evaluated on request at 20 equally spaced points inside every element;
+        :meth:`OptimalControlProblem.solve_adaptive` with ``bound_tol`` refines until it is
+        below a tolerance."""
+        if self._between is None:
+            return {}
+        return self._between(self)
 
     def summary(self) -> dict[str, Any]:
         """JSON-serialisable headline figures."""
