@@ -177,6 +177,37 @@ def _between_nodes_run() -> dict[str, Any]:
     return out
 
 
+def _continuation_run() -> dict[str, Any]:
+    """docs/optimize.rst's continuation: the bounded SMD's upper bound from 2 m to 1.6 m in
+    steps of 0.05 m on 150 elements of degree 3, each solve from the default guess, from the
+    previous result's states, and warm-started from it; IPOPT's iterations in all."""
+    import gmuk
+    from gmuk.optimize import Mesh, OptimalControlProblem
+
+    mesh = Mesh.uniform(0.0, 30.0, 150, 3)
+    out: dict[str, Any] = {}
+    for mode in ("cold", "primal", "warm"):
+        previous, total, last = None, 0, 0.0
+        for upper in np.round(np.arange(2.0, 1.59, -0.05), 2):
+            mass = gmuk.PointMass("mass", 2.0)
+            bound = gmuk.PlaneBound(mass, [1, 0, 0], lower=1.0, upper=float(upper), name="x")
+            spring = gmuk.LinearSpringDamper(10.0, 5.0, bodies=[mass])
+            system = gmuk.System([mass], [bound], [spring])
+            state = system.state(r={"mass": [1.5, 0, 0]}, v={"mass": [6.0, 0, 0]})
+            problem = OptimalControlProblem(system, state, 30.0)
+            if previous is None or mode == "cold":
+                r = problem.solve(mesh)
+            else:
+                r = problem.solve(mesh, guess=previous, warm_start=mode == "warm")
+            total, last, previous = total + r.iterations, r.objective, r
+        out[f"{mode}/iterations"] = total
+        out[f"{mode}/objective"] = last
+    out["agree"] = max(
+        abs(out[f"{m}/objective"] / out["cold/objective"] - 1) for m in ("primal", "warm")
+    )
+    return out
+
+
 def _thesis_nodes_run() -> dict[str, Any]:
     """smd-compare's SMD-BI on one element of degree 4 (the thesis's five nodes; the
     extremes of x between the nodes are ``x_direct_collocation_*``), and how far its
@@ -395,6 +426,9 @@ RUNS: dict[str, Run] = {
     ),
     "maintenance-slack-120": Run(
         "maintenance", {"slack_mass": "120", "compare": "false"}, seconds=90
+    ),
+    "optimize-continuation": Run(
+        "(docs/optimize.rst, continuation)", seconds=5, function=_continuation_run
     ),
     "optimize-between": Run(
         "(docs/optimize.rst, between the nodes)", 3, function=_between_nodes_run
@@ -1233,6 +1267,16 @@ _add(
     ("m to 8.6 m", "x_direct_collocation_max_m", "m to {:.1f} m"),
     ("0.934 m and 1.5", "x_direct_min_on_grid_m", "{:.3f} m and 1.5"),
     ("and 1.5 m (``x_direct", "x_direct_max_on_grid_m", "and {:.1f} m (``x_direct"),
+)
+
+# docs/optimize.rst, continuation ---------------------------------------------------------------
+_add(
+    OPT,
+    "optimize-continuation",
+    ("takes 227 IPOPT iterations", "cold/iterations", "takes {} IPOPT iterations"),
+    ("188 from each", "primal/iterations", "{} from each"),
+    ("and 144 warm-started", "warm/iterations", "and {} warm-started"),
+    ("optima (< 1e-9 relative apart;", "agree", "optima (< {:.0e} relative apart;", "", "below"),
 )
 
 # docs/optimize.rst, between the nodes ----------------------------------------------------------

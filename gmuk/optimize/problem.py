@@ -82,6 +82,18 @@ CALIBRATION_ELEMENTS = (16, 64)
 #: Factor on the build time extrapolated from the partial meshes (see above).
 BUILD_MARGIN = 1.5
 
+#: IPOPT's options for a warm start from a previous solution's point and multipliers: start
+#: from them, close to the solution (barrier parameter and bound pushes small).
+WARM_START_OPTIONS = {
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.mu_init": 1e-6,
+    "ipopt.warm_start_bound_push": 1e-3,
+    "ipopt.warm_start_bound_frac": 1e-3,
+    "ipopt.warm_start_slack_bound_push": 1e-3,
+    "ipopt.warm_start_slack_bound_frac": 1e-3,
+    "ipopt.warm_start_mult_bound_push": 1e-3,
+}
+
 #: Points per element, equally spaced between its ends, at which the path inequalities are
 #: evaluated between the nodes (``OptimalControlResult.violation_between_nodes``).
 BETWEEN_NODE_SAMPLES = 20
@@ -541,6 +553,7 @@ class OptimalControlProblem:
         n_elements: int = 50,
         degree: int = 3,
         guess: OptimalControlResult | None = None,
+        warm_start: bool = False,
         max_iter: int = 3000,
         max_cpu_time: float = 120.0,
         tol: float = 1e-8,
@@ -559,6 +572,12 @@ class OptimalControlProblem:
             A previous solution of a problem with the same bodies (any mesh covering
             [t0, tf]) to start from; default: the initial state held (moved linearly, and
             rotated about one axis, towards given final conditions).
+        warm_start : bool
+            With a ``guess`` solved on this same mesh (a changed parameter, say: a bound, a
+            mass, a final condition), start IPOPT from the guess's own point and
+            multipliers with its warm-start options (:data:`WARM_START_OPTIONS`) instead of
+            the guess's interpolated states alone; ``result.stats["warm_started"]`` says
+            whether it could. Default False.
         max_iter : int
             IPOPT's iteration limit, an integer in [0, 2³¹ − 1].
         max_cpu_time : float
@@ -596,10 +615,12 @@ class OptimalControlProblem:
         if not isinstance(mesh, Mesh):
             raise DefinitionError(f"mesh must be a gmuk.optimize.Mesh; got {type(mesh).__name__}")
         self._check_guess(guess)
+        if not isinstance(warm_start, (bool, np.bool_)):
+            raise DefinitionError(f"warm_start must be True or False; got {warm_start!r:.40}")
         self._check_build_time(mesh, budget)
         tr = _Transcription(self, mesh, budget=budget)
         budget.built = budget.elapsed()
-        result = tr.solve(guess=guess, budget=budget, **settings)
+        result = tr.solve(guess=guess, budget=budget, warm_start=bool(warm_start), **settings)
         if not result.success:
             raise OptimizationError(
                 f"IPOPT did not solve the problem: {result.status} after {result.iterations} "
@@ -1421,6 +1442,7 @@ class _Transcription:
         *,
         guess: OptimalControlResult | None,
         budget: _Budget,
+        warm_start: bool = False,
         max_iter: int,
         tol: float,
         log: bool,
@@ -1431,6 +1453,11 @@ class _Transcription:
         import casadi as ca
 
         x0, pbar = self.initial_guess(guess)
+        warm = self._warm_start(guess) if warm_start else None
+        multipliers: dict[str, Any] = {}
+        if warm is not None:  # the guess's own NLP point and multipliers
+            x0, pbar, lam_x0, lam_g0 = warm
+            multipliers = {"lam_x0": lam_x0, "lam_g0": lam_g0}
         x0 = np.clip(x0, self.lbx, self.ubx)
         tic = time.perf_counter()
         left = budget.remaining() - budget.reserve
@@ -1451,6 +1478,8 @@ class _Transcription:
             os.close(fd)
             opts["ipopt.output_file"] = log_path
             opts["ipopt.file_print_level"] = 5
+        if warm is not None:
+            opts.update(WARM_START_OPTIONS)
         opts.update(ipopt_options)
         opts.update(self.derivatives)
         nlp = {"x": self.x, "p": self.p, "f": self.f, "g": self.g}
@@ -1468,7 +1497,9 @@ class _Transcription:
                 os.unlink(log_path)
             raise
         tic = time.perf_counter()
-        out = solver(x0=x0, p=pbar, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        out = solver(
+            x0=x0, p=pbar, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg, **multipliers
+        )
         solve_s = time.perf_counter() - tic
         stats = solver.stats()
         text = None
@@ -1485,14 +1516,55 @@ class _Transcription:
         history = {
             k: np.asarray(iters.get(k, []), dtype=float) for k in ("obj", "inf_pr", "inf_du", "mu")
         }
+        evaluations = sum(
+            float(v) for k, v in stats.items() if k.startswith("t_wall_nlp_") and v == v
+        )
         timings = {
             "transcription_s": budget.built + setup,
             "solve_s": solve_s,
+            # of solve_s: the NLP's functions and derivatives, and IPOPT's own work
+            "evaluations_s": evaluations,
+            "ipopt_s": max(solve_s - evaluations, 0.0),
             "total_s": budget.built + setup + solve_s,
         }
         return self._result(
-            x, pbar, lam_g, lam_x, gval, float(out["f"]), stats, history, text, timings, viol
+            x,
+            pbar,
+            lam_g,
+            lam_x,
+            gval,
+            float(out["f"]),
+            stats,
+            history,
+            text,
+            timings,
+            viol,
+            warm_started=warm is not None,
         )
+
+    def _warm_start(
+        self, guess: OptimalControlResult | None
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None:
+        """The guess's own NLP point, parameters and multipliers, when it was solved on this
+        mesh with an NLP of this layout (same variables and rows); None otherwise."""
+        nlp = None if guess is None else guess._nlp
+        if nlp is None or guess is None:
+            return None
+        x, p, lam_x, lam_g = nlp
+        same_mesh = guess.mesh.degrees == self.mesh.degrees and np.array_equal(
+            guess.mesh.breaks, self.mesh.breaks
+        )
+        if self.free:  # the guess's mesh is scaled to its final time: compare fractions
+            span = guess.mesh.tf - guess.mesh.t0
+            mine = (self.mesh.breaks - self.mesh.t0) / (self.mesh.tf - self.mesh.t0)
+            same_mesh = guess.mesh.degrees == self.mesh.degrees and np.allclose(
+                (guess.mesh.breaks - guess.mesh.t0) / span, mine, rtol=0.0, atol=1e-14
+            )
+        if not same_mesh or x.size != self.n_x or lam_g.size != self.lbg.size:
+            return None
+        if p.size != 9 * (self.problem.n_th // 3) * self.mesh.n_elements:
+            return None
+        return x.copy(), p.copy(), lam_x.copy(), lam_g.copy()
 
     def path_values(
         self, x: FloatArray, gval: FloatArray, lam_g: FloatArray, lam_x: FloatArray
@@ -1571,6 +1643,7 @@ class _Transcription:
         text: str | None,
         timings: dict[str, float],
         violation: float,
+        warm_started: bool = False,
     ) -> OptimalControlResult:
         pb, mesh = self.problem, self.mesh
         Y, U, TH, PHI = self._unpack(x)
@@ -1618,9 +1691,11 @@ class _Transcription:
                 "n_variables": int(x.size),
                 "n_constraints": int(gval.size),
                 "t_final": float(times[-1]),
+                "warm_started": bool(warm_started),
             },
             _kkt=_KKTEvaluator(self, x, pbar, lam_g, lam_x),
             _between=lambda res: self.bound_violations(res)[1],
+            _nlp=(x.copy(), np.asarray(pbar, dtype=float).copy(), lam_x.copy(), lam_g.copy()),
         )
 
     # ------------------------------------------------------------------ between the nodes

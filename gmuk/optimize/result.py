@@ -209,6 +209,10 @@ class OptimalControlResult:
     _between: Callable[[OptimalControlResult], dict[str, float]] | None = field(
         default=None, repr=False
     )
+    #: the NLP's solution x, parameters p and multipliers λ_x, λ_g (a warm start's)
+    _nlp: tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None = field(
+        default=None, repr=False
+    )
 
     def __repr__(self) -> str:
         return (
