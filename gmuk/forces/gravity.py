@@ -320,10 +320,21 @@ class SphericalHarmonicGravity(ForceModel):
     (:class:`~gmuk.celestial.UniformRotation`) in a :class:`~gmuk.gravity.SphericalHarmonicField`
     the force is :func:`harmonic_point_load`, the kernel the compiled loop calls; other
     rotation models and fields are evaluated in Python through the field's ``acceleration``.
+
+    The symbolic (CasADi) forms for :mod:`gmuk.optimize`, :meth:`casadi_force` and
+    :meth:`casadi_wrench`, need a :class:`~gmuk.gravity.SphericalHarmonicField` (its
+    :meth:`~gmuk.gravity.SphericalHarmonicField.casadi_acceleration`: the kernel's recurrences
+    in CasADi). The central body's rotation enters as ``R_FN(t)``: for a
+    :class:`~gmuk.celestial.UniformRotation` written with ``cos``/``sin`` of the time, which
+    may be symbolic; for any other rotation model only at a numeric time (the optimiser then
+    transcribes element by element with the nodes' times). On a rigid body the Hessian and
+    the finite-size force's third derivatives are CasADi's exact derivatives of the
+    acceleration (the numeric :meth:`wrench` takes the latter by central differences; the two
+    differ by far less than the round-off of the total force).
     """
 
     _kernel = staticmethod(harmonic_point_load)
-    _forms = Forms(compiled=True, symbolic="no CasADi form of a spherical-harmonic field yet")
+    _forms = Forms(compiled=True, symbolic=True)
 
     def __init__(
         self,
@@ -372,6 +383,85 @@ class SphericalHarmonicGravity(ForceModel):
             return self._kernel_load(False, t, r_N, v_N, body)
         R_FN = self.central_body.rotation.R_FN(t)
         return body.mass * (R_FN.T @ self.field.acceleration(R_FN @ r_N))
+
+    def casadi_force(self, t: Any, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force`: ``m R_FN(t)ᵀ ∇U(R_FN(t) r_N)`` (CasADi, 3×1, N).
+
+        Parameters
+        ----------
+        t : float or casadi.SX or casadi.MX
+            Time (s); symbolic only for a :class:`~gmuk.celestial.UniformRotation`.
+        r_N : casadi.SX, casadi.MX or casadi.DM, shape (3, 1)
+            Position in N (m).
+        v_N : any
+            Unused.
+        body : Body
+
+        Raises
+        ------
+        DefinitionError
+            For a field that is not a :class:`~gmuk.gravity.SphericalHarmonicField`, or a
+            symbolic time with a rotation model other than UniformRotation.
+        """
+        R_FN = self._casadi_R_FN(t)
+        a_F = self.field.casadi_acceleration(R_FN @ r_N)
+        return body.mass * (R_FN.T @ a_F)
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench`: [L; f] in the body frame (CasADi, 6×1; N·m, N).
+
+        ``L = (J H_B − H_B J)^∨``, ``f = R_FBᵀ (m ∇U + ½ ∇(tr(H Π)))`` with H = ∇∇U and its
+        gradient CasADi's exact derivatives of the field's symbolic acceleration
+        (:func:`gmuk.gravity._symbolic.rigid_function`); the finite-size term only with
+        ``finite_size_force``. Arguments and errors as :meth:`casadi_force` (g_NB 4×4 in N,
+        m; V_B unused).
+        """
+        from gmuk.gravity import _symbolic
+
+        ca = casadi()
+        R_FN = self._casadi_R_FN(t)
+        R_FB = R_FN @ g_NB[:3, :3]
+        r_F = R_FN @ g_NB[:3, 3]
+        J = np.asarray(body.inertia, dtype=float)
+        Pi_B = ca.DM(0.5 * np.trace(J) * np.eye(3) - J)
+        fn = _symbolic.rigid_function(self.field, finite_size=self.include_finite_size_force)
+        a_F, H_F, s_F = fn(r_F, R_FB @ Pi_B @ R_FB.T)
+        H_B = R_FB.T @ H_F @ R_FB
+        JH = ca.DM(J) @ H_B - H_B @ ca.DM(J)
+        f_B = R_FB.T @ (body.mass * a_F + s_F)
+        return ca.vertcat(JH[2, 1], JH[0, 2], JH[1, 0], f_B)
+
+    def _symbolic_field(self) -> None:
+        """Raise the DefinitionError of a field without a CasADi form."""
+        if type(self.field) is not SphericalHarmonicField:
+            raise DefinitionError(
+                f"{self.name}: the symbolic (CasADi) form of SphericalHarmonicGravity needs a "
+                f"gmuk.gravity.SphericalHarmonicField; this model's field is a "
+                f"{type(self.field).__name__}, which has no CasADi form"
+            )
+
+    def _casadi_R_FN(self, t: Any) -> Any:
+        """R_FN(t) (3×3) as a CasADi matrix: of ``cos``/``sin`` of a symbolic t for a
+        :class:`~gmuk.celestial.UniformRotation`, the rotation model's numbers at a numeric t
+        (any model); a DefinitionError for a symbolic t with another model."""
+        ca = casadi()
+        self._symbolic_field()
+        rot = self.central_body.rotation
+        if isinstance(t, (ca.SX, ca.MX)):
+            if type(rot) is not UniformRotation:
+                raise DefinitionError(
+                    f"{self.name}: the symbolic (CasADi) form of SphericalHarmonicGravity "
+                    "takes a symbolic time only for a central body spinning uniformly "
+                    f"(gmuk.UniformRotation); {self.central_body.name}'s rotation is a "
+                    f"{type(rot).__name__}, supported at numeric times only (gmuk.optimize "
+                    "then transcribes element by element)"
+                )
+            eta = rot.angle0 + rot.rate * t
+            c, s = ca.cos(eta), ca.sin(eta)
+            return ca.vertcat(
+                ca.horzcat(c, s, 0.0), ca.horzcat(-s, c, 0.0), ca.horzcat(0.0, 0.0, 1.0)
+            )
+        return ca.DM(rot.R_FN(float(t)))
 
     def _kernel_params(self, body: Body) -> tuple[tuple[float, float], Any] | None:
         """(η₀, ω) and the field's data for a point mass in a

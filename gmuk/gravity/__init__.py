@@ -10,6 +10,8 @@ Public API
   the three in one pass; ``acceleration_hessian`` is the lean call for ∇U and ∇∇U
   together). ``central=False`` gives the perturbation only (every term but
   C̄₀₀), which is what rigid-body force models add to their point-mass part.
+  ``casadi_acceleration`` is the acceleration's symbolic (CasADi) form for
+  :mod:`gmuk.optimize`: the same recurrences and constants (:mod:`gmuk.gravity._symbolic`).
 * :func:`load` ``(name, degree=None)``: a field shipped with gmuk by name,
   ``"GRGM660PRIM"`` (Moon, GRAIL, to degree 150) or ``"EGM2008"`` (Earth, to degree 70);
   :func:`available` lists them (provenance and licence in ``gmuk/gravity/data/README.md``).

@@ -521,6 +521,46 @@ class SphericalHarmonicField:
         v = self._batch(_points(r_F), _ACC | _HES, central)
         return v.acceleration, v.hessian  # type: ignore[return-value]
 
+    def casadi_acceleration(self, r_F: Any, *, central: bool = True) -> Any:
+        """The symbolic (CasADi) form of :meth:`acceleration`, for :mod:`gmuk.optimize`.
+
+        The same recurrences, normalisation and constants as the compiled kernel (read from
+        this field's data), written in CasADi operations (:mod:`gmuk.gravity._symbolic`):
+        CasADi can differentiate it exactly. The expression is built once per field and
+        kept (a cache of recently used fields).
+
+        Parameters
+        ----------
+        r_F : casadi.SX, casadi.MX, casadi.DM or array_like, 3 entries
+            One position in the body-fixed frame F (m).
+        central : bool
+            Include the central term (default) or give the perturbation only.
+
+        Returns
+        -------
+        casadi.SX, casadi.MX or casadi.DM, shape (3, 1)
+            ∇U in frame F (m/s²): SX for an SX position (the expression itself), MX for MX (a
+            call of the field's CasADi Function), DM for numbers.
+
+        Raises
+        ------
+        MissingDependencyError
+            Without CasADi.
+        ShapeError
+            If ``r_F`` does not have 3 entries.
+
+        Notes
+        -----
+        Plain double precision, without the kernel's extended exponents (where the seeds
+        underflow, near the poles at high order, their terms are negligible; see
+        :mod:`gmuk.gravity._symbolic`). It agrees with :meth:`acceleration` to about 1e-15
+        relative up to the shipped degree 150, poles included
+        (``tests/forces/test_harmonic_symbolic.py``).
+        """
+        from gmuk.gravity import _symbolic
+
+        return _symbolic.acceleration(self, r_F, central=central)
+
     def evaluate(
         self,
         r_F: Any,
