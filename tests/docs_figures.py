@@ -2229,3 +2229,125 @@ _add(
     ("1360.52 N²·s/kg, *below*", "objective", "{:.2f} N²·s/kg, *below*"),
     ("below 1e-14) matching", "P_minus_D", "below {:.0e}) matching", "", "below"),
 )
+
+
+# docs/optimize_lunar.rst: the spherical-harmonic field in gmuk.optimize ----------------------
+def _lunar_correction() -> dict[str, Any]:
+    """docs/optimize_lunar.rst's figures: the station-keeping table of
+    examples/optimal_lunar_correction.py (whose ``rows`` computes it), and the symbolic
+    field's agreement with the kernel and its size."""
+    import importlib.util
+
+    import gmuk
+    from gmuk.gravity import _symbolic
+
+    spec = importlib.util.spec_from_file_location(
+        "optimal_lunar_correction", ROOT / "examples" / "optimal_lunar_correction.py"
+    )
+    assert spec is not None and spec.loader is not None
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    out: dict[str, Any] = {
+        f"{row['elements']}/{key}": value for row in example.rows() for key, value in row.items()
+    }
+    rng = np.random.default_rng(0)
+    for degree in (20, 50, 150):
+        field = gmuk.gravity.load("GRGM660PRIM", degree)
+        fn = _symbolic.acceleration_function(field)
+        out[f"field_{degree}/instructions"] = fn.n_instructions()
+        u = rng.normal(size=(200, 3))
+        r = u / np.linalg.norm(u, axis=1)[:, None] * rng.uniform(1.74e6, 5e6, (200, 1))
+        worst = 0.0
+        for x in r:
+            a = field.acceleration(x)
+            worst = max(worst, float(np.abs(np.asarray(fn(x)).ravel() - a).max() / np.abs(a).max()))
+        out[f"field_{degree}/agreement"] = worst
+    # the field's perturbation against the central attraction along the Keplerian orbit
+    _, _, orbit = example.setting()
+    moon = gmuk.CelestialBody.moon(field=gmuk.gravity.load("GRGM660PRIM", 20))
+    t = np.linspace(0.0, orbit.period, 2001)
+    r_F = moon.to_fixed(t, orbit.state(t)[0])
+    perturbation = moon.field.acceleration(r_F, central=False)
+    central = moon.field.acceleration(r_F) - perturbation
+    out["perturbation_ratio"] = float(
+        (np.linalg.norm(perturbation, axis=1) / np.linalg.norm(central, axis=1)).max()
+    )
+    out["objective_change_40_80"] = abs(out["40/objective"] / out["80/objective"] - 1.0)
+    # the rigid form's exact finite-size force against the numeric central differences
+    field = gmuk.gravity.load("GRGM660PRIM", 20)
+    model = gmuk.SphericalHarmonicGravity(gmuk.CelestialBody.moon(field=field))
+    body = gmuk.RigidBody("big", 1e5, np.diag([2e8, 3e8, 4.5e8]))
+    Pi_B = 0.5 * np.trace(body.inertia) * np.eye(3) - body.inertia
+    rigid = _symbolic.rigid_function(field, finite_size=True)
+    worst = 0.0
+    for _ in range(30):
+        u = rng.normal(size=3)
+        g = np.eye(4)
+        g[:3, :3] = gmuk.lie.so3.exp(rng.normal(size=3))
+        g[:3, 3] = u / np.linalg.norm(u) * rng.uniform(1.76e6, 4e6)
+        exact = np.asarray(rigid(g[:3, 3], g[:3, :3] @ Pi_B @ g[:3, :3].T)[2]).ravel()
+        differences = g[:3, :3] @ model.finite_size_force(0.0, g, body)
+        worst = max(worst, float(np.abs(exact - differences).max() / np.abs(differences).max()))
+    out["finite_size_vs_differences"] = worst
+    return out
+
+
+RUNS["optimize-lunar"] = Run(
+    "(python examples/optimal_lunar_correction.py)", seconds=14, function=_lunar_correction
+)
+LUN = "docs/optimize_lunar.rst"
+_add(
+    LUN,
+    "optimize-lunar",
+    ("T = 7070.9 s", "40/period_s", "T = {:.1f} s"),
+    ("ends 2680.6 m from", "40/free_miss_m", "ends {:.1f} m from"),
+    ("ΔV = 0.976279 m/s", "40/delta_v_m_s", "ΔV = {:.6f} m/s"),
+    ("flown one ends 1.3e-4 m", "40/flown_final_miss_m", "flown one ends {:.1e} m"),
+    ("velocity to 1.1e-5 m/s", "40/flown_vs_plan_m_s", "velocity to {:.1e} m/s"),
+    ("(5 821 instructions", "field_20/instructions", "({:,} instructions"),
+    ("33 278 at degree 50", "field_50/instructions", "{:,} at degree 50"),
+    ("287 302 at degree 150", "field_150/instructions", "{:,} at degree 150"),
+    ("degree 20: < 3e-15", "field_20/agreement", "degree 20: < {:.0e}", "", "below"),
+    ("degree 50: < 3e-15", "field_50/agreement", "degree 50: < {:.0e}", "", "below"),
+    ("degree 150: < 3e-15", "field_150/agreement", "degree 150: < {:.0e}", "", "below"),
+    ("agree to 4.4e-10 of that", "finite_size_vs_differences", "agree to {:.1e} of that"),
+    ("agree to 8.3e-4 m", "40/flown_vs_plan_m", "agree to {:.1e} m"),
+    ("iterations: 8 from", "40/guess_iterations", "iterations: {} from"),
+    ("at most 9.5e-4 of the", "perturbation_ratio", "at most {:.1e} of the"),
+    ("thrust of 61 mN", "40/peak_thrust_N*1000", "thrust of {:.0f} mN"),
+    ("(0.20 mm/s²)", "40/peak_thrust_N*3.3333333333333335", "({:.2f} mm/s²)"),
+    ("one to 8.3e-4 m in", "40/flown_vs_plan_m", "one to {:.1e} m in"),
+    ("change 3.4e-8 from", "objective_change_40_80", "change {:.1e} from"),
+    ("at most 1.6e-6 m on 40", "40/halved_steps_m", "at most {:.1e} m on 40"),
+    ("(6.4e-7 m on 80)", "80/halved_steps_m", "({:.1e} m on 80)"),
+    ("moved them by 8.6e-5 m", "40/unbounded_steps_m", "moved them by {:.1e} m"),
+    ("and 1.6e-5 m on 80", "80/unbounded_steps_m", "and {:.1e} m on 80"),
+)
+_LUNAR = {
+    20: ("81", "2", "4.522013732e-2", "0.976284", "0.06116", "1.7"),
+    40: ("161", "2", "4.521978059e-2", "0.976279", "0.06117", "8.3e-4"),
+    80: ("321", "8", "4.521977905e-2", "0.976279", "0.06117", "1.4e-5"),
+}
+for _n, (_nodes, _it, _objective, _dv, _peak, _flown) in _LUNAR.items():
+    _near = f"   * - {_n}"
+    _add(
+        LUN,
+        "optimize-lunar",
+        (f"- {_nodes}", f"{_n}/nodes", "- {}", _near),
+        (f"- {_it}", f"{_n}/iterations", "- {}", _near),
+        (f"- {_objective}", f"{_n}/objective", "- {:.9e}", _near),
+        (f"- {_dv}", f"{_n}/delta_v_m_s", "- {:.6f}", _near),
+        (f"- {_peak}", f"{_n}/peak_thrust_N", "- {:.5f}", _near),
+        (f"- {_flown}", f"{_n}/flown_vs_plan_m", "- {:.1f}" if _n == 20 else "- {:.1e}", _near),
+    )
+TIMINGS += [
+    (LUN, "0.03 s at degree 20", "2026-11-28, 2-core Xeon, load ≈ 1.5, --timings"),
+    (LUN, "0.5 s at degree 150", "2026-11-28, 2-core Xeon, load ≈ 1.5, --timings"),
+    (LUN, "0.28 s for 40 elements", "2026-11-28, 2-core Xeon, --timings"),
+    (LUN, "0.31 s for 160", "2026-11-28, 2-core Xeon, --timings"),
+    (LUN, "0.02 s and 0.05 s", "2026-11-28, the same with PointMassGravity, --timings"),
+    (LUN, "take 0.011 s", "2026-11-28, five casadi_force calls and their Function, --timings"),
+    (LUN, "2.9 s at degree 20", "2026-11-28, rigid body, 40 elements, --timings"),
+    (LUN, "8.0 s with it", "2026-11-28, rigid body, finite-size force, --timings"),
+    (LUN, "about 10 s", "2026-11-28, python examples/optimal_lunar_correction.py"),
+]

@@ -39,6 +39,16 @@ CHECKS = {
         and r["orthogonality"] < 1e-10
         and r["flown_vs_plan_rad"] < 1e-4
     ),
+    # the planned station keeping converges and the simulator, running the compiled field,
+    # flies it to a millimetre (the collocation error on 40 elements: 8.3e-4 m)
+    "optimal_lunar_correction.py": lambda r: (
+        r["status"] == "Solve_Succeeded"
+        and r["iterations"] < 20
+        and 0.5 < r["delta_v_m_s"] < 2.0
+        and r["free_miss_m"] > 1e3
+        and r["flown_vs_plan_m"] < 1e-2
+        and r["flown_final_miss_m"] < 1e-2
+    ),
     "free_rigid_body.py": lambda r: r["energy_drift"] < 1e-10 and r["orthogonality"] < 1e-13,
     "spherical_pendulum.py": lambda r: r["radius_error_m"] < 1e-8 and r["mean_tension_N"] > 0,
     "virtual_pair.py": lambda r: r["locked_components_max"] < 1e-9 and r["roll_vs_analytic"] < 1e-8,
