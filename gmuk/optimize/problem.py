@@ -759,11 +759,6 @@ class OptimalControlProblem:
         OptimalControlResult
             The last solve's, with ``refinement`` the list of :class:`RefinementStep`.
         """
-        if self.tf_bounds is not None:
-            raise DefinitionError(
-                "solve_adaptive refines a mesh of fixed span; with free_final_time, refine by "
-                "hand: solve on a finer mesh with guess= the previous result"
-            )
         tol = real_number(tol, "tol", positive=True)
         rounds = strict_integer(max_rounds, "max_rounds", minimum=1)
         most = strict_integer(max_elements, "max_elements", minimum=1)
@@ -775,7 +770,10 @@ class OptimalControlProblem:
         result = None
         for rnd in range(rounds):
             result = self.solve(mesh, guess=guess, **options)
-            tr = _Transcription(self, mesh, build=False)
+            # with a free final time the estimates are of the result's mesh (scaled to its
+            # final time); the split applies to the same elements of the unscaled one
+            free = self.tf_bounds is not None
+            tr = _Transcription(self, result.mesh if free else mesh, build=False, part=free)
             errors = tr.element_errors(result)
             emax = float(errors.max())
             violations = np.zeros(mesh.n_elements)
@@ -819,8 +817,10 @@ class _Transcription:
         budget: _Budget | None = None,
         part: bool = False,
     ) -> None:
-        """``part``: a mesh of the first elements only (to time the build, see
-        :meth:`OptimalControlProblem._check_build_time`); ``budget``: the clock to check."""
+        """``part``: a mesh that need not span the problem (the first elements only, to time
+        the build, see :meth:`OptimalControlProblem._check_build_time`; a result's mesh
+        scaled to its free final time, for its error estimates); ``budget``: the clock to
+        check."""
         if not isinstance(mesh, Mesh):
             raise DefinitionError(f"mesh must be a gmuk.optimize.Mesh; got {type(mesh).__name__}")
         self.budget = budget or _Budget(float("inf"))

@@ -116,6 +116,12 @@ def test_bad_control_bounds_and_final_time_options_are_refused(options, message)
         _slew(**options)
 
 
-def test_adaptive_refinement_of_a_free_final_time_is_refused_saying_what_to_do():
-    with pytest.raises(DefinitionError, match="guess= the previous result"):
-        _minimum_time().solve_adaptive()
+def test_adaptive_refinement_with_a_free_final_time_closes_in_on_the_switch():
+    # 5 elements: the switch at mid-slew falls inside the middle element, which the
+    # estimates split until the smeared switch no longer moves the final time much
+    t_final = 2.0 * np.sqrt(THETA * J_Z / TAU_MAX)
+    r = _minimum_time().solve_adaptive(Mesh.uniform(0.0, 20.0, 5, 3), tol=1e-6, max_rounds=6)
+    first = r.refinement[0]
+    assert len(r.refinement) > 1 and r.mesh.n_elements > 5
+    assert abs(r.stats["t_final"] - t_final) < 1e-2 * abs(first.objective - t_final)
+    assert r.mesh.tf == pytest.approx(r.stats["t_final"], rel=1e-14)
