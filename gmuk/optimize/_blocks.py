@@ -73,11 +73,16 @@ def _nonzeros(M: Any) -> tuple[Any, np.ndarray, np.ndarray]:
     return ca.vertcat(*M.nonzeros()) if M.nnz() else ca.SX(0, 1), np.array(rows), np.array(cols)
 
 
-def _assembled(n_rows: int, n_cols: int, rows: np.ndarray, cols: np.ndarray, values: Any) -> Any:
-    """The sparse n_rows × n_cols MX matrix with ``values[e]`` added at (rows[e], cols[e])."""
+def _assembled(
+    n_rows: int, n_cols: int, rows: list[np.ndarray], cols: list[np.ndarray], values: list[Any]
+) -> Any:
+    """The sparse n_rows × n_cols MX matrix with each entry of the concatenated ``values``
+    added at its (row, column) of the concatenated ``rows`` and ``cols``."""
     import casadi as ca
 
-    key = cols.astype(np.int64) * n_rows + rows
+    r = np.concatenate(rows) if rows else np.zeros(0, dtype=int)
+    c = np.concatenate(cols) if cols else np.zeros(0, dtype=int)
+    key = c.astype(np.int64) * n_rows + r
     unique, position = np.unique(key, return_inverse=True)
     sp = ca.Sparsity.triplet(
         n_rows, n_cols, (unique % n_rows).astype(int).tolist(), (unique // n_rows).tolist()
@@ -86,7 +91,8 @@ def _assembled(n_rows: int, n_cols: int, rows: np.ndarray, cols: np.ndarray, val
         ca.Sparsity.triplet(unique.size, key.size, position.tolist(), list(range(key.size))),
         1.0,
     )
-    return ca.MX(sp, ca.densify(summing @ values))
+    nonzeros = ca.vertcat(*values) if values else ca.MX(0, 1)
+    return ca.MX(sp, ca.densify(summing @ nonzeros))
 
 
 def derivative_functions(
@@ -169,33 +175,11 @@ def derivative_functions(
         raise AssertionError("the blocks must produce every row of g once")
     g = ca.vertcat(*g_values)[order.tolist()] if n_g else ca.MX(0, 1)
 
-    def cat(parts: list[Any], empty: Any) -> Any:
-        return ca.vertcat(*parts) if parts else empty
-
-    int0 = np.zeros(0, dtype=int)
-    jac_g = _assembled(
-        n_g,
-        n_x,
-        np.concatenate(jac[0]) if jac[0] else int0,
-        np.concatenate(jac[1]) if jac[1] else int0,
-        cat(jac[2], ca.MX(0, 1)),
-    )
+    jac_g = _assembled(n_g, n_x, *jac)
     grad_f = ca.densify(
-        _assembled(
-            n_x,
-            1,
-            np.concatenate(grad[0]) if grad[0] else int0,
-            np.zeros(sum(len(r) for r in grad[0]), dtype=int),
-            cat(grad[1], ca.MX(0, 1)),
-        )
+        _assembled(n_x, 1, grad[0], [np.zeros(len(r), dtype=int) for r in grad[0]], grad[1])
     )
-    hess_l = _assembled(
-        n_x,
-        n_x,
-        np.concatenate(hess[0]) if hess[0] else int0,
-        np.concatenate(hess[1]) if hess[1] else int0,
-        cat(hess[2], ca.MX(0, 1)),
-    )
+    hess_l = _assembled(n_x, n_x, *hess)
     functions = {
         "grad_f": ca.Function("nlp_grad_f", [x, p], [f, grad_f]),
         "jac_g": ca.Function("nlp_jac_g", [x, p], [g, jac_g]),

@@ -258,6 +258,17 @@ class OptimalControlProblem:
         self._check_boundaries()
 
     # ------------------------------------------------------------------ set-up
+    def _plan_named(self, name: Any, where: str) -> _BodyPlan:
+        """The plan of the physical body ``name``; a DefinitionError naming ``where`` and the
+        problem's bodies otherwise."""
+        plan = self._by_name.get(name) if isinstance(name, str) else None
+        if plan is None:
+            raise DefinitionError(
+                f"{where} names unknown body {name!r}; the problem's bodies are "
+                f"{sorted(self._by_name)}"
+            )
+        return plan
+
     def _control_bounds(self, bounds: Any) -> tuple[FloatArray, FloatArray]:
         """Per control component: lower and upper bound (−inf/inf where none)."""
         lower, upper = np.full(self.n_u, -np.inf), np.full(self.n_u, np.inf)
@@ -269,12 +280,7 @@ class OptimalControlProblem:
                 f"{{'sat': (-0.1, 0.1)}}; got {type(bounds).__name__}"
             )
         for name, pair in bounds.items():
-            plan = self._by_name.get(name) if isinstance(name, str) else None
-            if plan is None:
-                raise DefinitionError(
-                    f"control_bounds: {name!r} is not a body of the problem; its bodies are "
-                    f"{sorted(self._by_name)}"
-                )
+            plan = self._plan_named(name, "control_bounds")
             if not isinstance(pair, (tuple, list)) or len(pair) != 2:
                 raise DefinitionError(
                     f"control_bounds[{name!r}] must be (lower, upper); got {pair!r:.60}"
@@ -401,12 +407,7 @@ class OptimalControlProblem:
             )
         for key, values in spec.items():
             for name, value in values.items():
-                plan = self._by_name.get(name) if isinstance(name, str) else None
-                if plan is None:
-                    raise DefinitionError(
-                        f"final[{key!r}] names unknown body {name!r}; bodies are "
-                        f"{sorted(self._by_name)}"
-                    )
+                plan = self._plan_named(name, f"final[{key!r}]")
                 if plan.rigid != (key in ("g", "V")):
                     raise DefinitionError(
                         f"final[{key!r}][{name!r}]: {key!r} is for "

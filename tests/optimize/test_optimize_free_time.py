@@ -99,7 +99,7 @@ def test_control_bounds_hold_at_every_node():
     ("options", "message"),
     [
         ({"control_bounds": [(-1, 1)]}, "must map body names"),
-        ({"control_bounds": {"nobody": (-1, 1)}}, "not a body of the problem"),
+        ({"control_bounds": {"nobody": (-1, 1)}}, "names unknown body"),
         ({"control_bounds": {"sat": (-1, 1, 2)}}, r"must be \(lower, upper\)"),
         ({"control_bounds": {"sat": ([-1, -1], 1)}}, "6 numbers"),
         ({"control_bounds": {"sat": (float("nan"), 1)}}, "not NaN"),
