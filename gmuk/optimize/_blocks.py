@@ -83,13 +83,13 @@ def _assembled(
     r = np.concatenate(rows) if rows else np.zeros(0, dtype=int)
     c = np.concatenate(cols) if cols else np.zeros(0, dtype=int)
     key = c.astype(np.int64) * n_rows + r
-    unique, position = np.unique(key, return_inverse=True)
-    sp = ca.Sparsity.triplet(
-        n_rows, n_cols, (unique % n_rows).astype(int).tolist(), (unique // n_rows).tolist()
-    )
+    unique, position = np.unique(key, return_inverse=True)  # sorted: column-major order
+    columns = unique // n_rows
+    colind = np.searchsorted(columns, np.arange(n_cols + 1))
+    sp = ca.Sparsity(n_rows, n_cols, colind.tolist(), (unique % n_rows).tolist())
+    # entry e of the values adds to nonzero position[e]: one nonzero per column
     summing = ca.DM(
-        ca.Sparsity.triplet(unique.size, key.size, position.tolist(), list(range(key.size))),
-        1.0,
+        ca.Sparsity(unique.size, key.size, list(range(key.size + 1)), position.tolist()), 1.0
     )
     nonzeros = ca.vertcat(*values) if values else ca.MX(0, 1)
     return ca.MX(sp, ca.densify(summing @ nonzeros))

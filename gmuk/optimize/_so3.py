@@ -20,6 +20,7 @@ exponential map and its differential on SO(3)); Iserles et al. (2000), Lie-group
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -47,7 +48,19 @@ def _horner(coeffs: np.ndarray, s: Any) -> Any:
 
 def coefficients(s: Any) -> tuple[Any, Any, Any]:
     """a, b, c at s = θ·θ (numbers or CasADi expressions)."""
-    return _horner(_A, s), _horner(_B, s), _horner(_C, s)
+    if isinstance(s, (int, float, np.floating)):
+        return _horner(_A, s), _horner(_B, s), _horner(_C, s)
+    return tuple(_coefficients_function()(s))
+
+
+@functools.cache
+def _coefficients_function() -> Any:
+    """The three series as one CasADi Function of s, built once: called with SX it expands
+    to the same expressions as the Horner loops, without building them again in Python."""
+    import casadi as ca
+
+    s = ca.SX.sym("s")
+    return ca.Function("so3_series", [s], [_horner(_A, s), _horner(_B, s), _horner(_C, s)])
 
 
 def exp_numeric(theta: np.ndarray) -> np.ndarray:

@@ -46,6 +46,7 @@ would only couple position into the attitude's chart for no gain.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 import tempfile
 import time
@@ -166,6 +167,11 @@ class OptimalControlProblem:
         Weight (cost units per s, ≥ 0) of the elapsed time ``t_f − t0`` added to the cost;
         with ``cost=lambda t, q, nu, u: 0`` and bounded controls, a minimum-time problem.
         Needs ``free_final_time``. Default 0.
+    eliminate_idle : bool
+        Hold at zero, rather than solve for, the state and control components that the
+        problem's structure proves zero at an optimum (:attr:`idle`: a point mass moved
+        along one axis, the translation of a body that only turns): the same optimum with a
+        smaller NLP. Default True.
 
     Raises
     ------
@@ -191,6 +197,7 @@ class OptimalControlProblem:
         control_bounds: Mapping[str, Any] | None = None,
         free_final_time: tuple[float, float] | None = None,
         time_cost: float = 0.0,
+        eliminate_idle: bool = True,
     ) -> None:
         from gmuk.engine.system import System
 
@@ -247,6 +254,11 @@ class OptimalControlProblem:
         self._final_y, self._final_R = self._final_values(final)
         self.u_lower, self.u_upper = self._control_bounds(control_bounds)
         self.tf_bounds = self._free_final_time(free_final_time)
+        if not isinstance(eliminate_idle, (bool, np.bool_)):
+            raise DefinitionError(
+                f"eliminate_idle must be True or False; got {eliminate_idle!r:.40}"
+            )
+        self.eliminate_idle = bool(eliminate_idle)
         self.time_cost = real_number(time_cost, "time_cost")
         if self.time_cost < 0.0:
             raise DefinitionError(f"time_cost must be ≥ 0; got {self.time_cost}")
@@ -516,6 +528,76 @@ class OptimalControlProblem:
             else:
                 blocks += [y[p.y + 3 : p.y + 6], Q / p.body.mass]
         return ca.vertcat(*blocks)
+
+    @functools.cached_property
+    def idle(self) -> tuple[np.ndarray, np.ndarray]:
+        """The state and control components (indices into y and u) that are zero at the
+        optimum by the problem's structure, so that the transcription holds them at zero
+        instead of solving for them: a point mass moved along one axis only, say, or the
+        translation of a body that only slews.
+
+        A set Z of components qualifies when, with every component in Z held at zero, any
+        feasible trajectory stays feasible and costs no more — so an optimum of the problem
+        restricted to Z = 0 is an optimum of the whole. Checked symbolically, on CasADi's
+        expressions of the parts, and only what is proved is used:
+
+        * every state in Z starts at zero, and ends at zero or free; every control in Z may
+          be zero (its bounds admit 0);
+        * the dynamics of a state in Z vanish identically when Z is zero (CasADi simplifies
+          them to a structural zero), so Z = 0 is a solution;
+        * the dynamics of the other states, the attitude charts' rates, every path
+          constraint and a user's running cost do not depend on Z at all;
+        * the default cost uᵀM⁻¹u has no cross term between controls in Z and the others
+          (M⁻¹ is block-diagonal there), so zeroing them lowers it.
+
+        Z starts as every component allowed by the first rule and shrinks to a fixed point.
+        """
+        import casadi as ca
+
+        n_y, n_u = self.n_y, self.n_u
+        y, u = ca.SX.sym("y", n_y), ca.SX.sym("u", n_u)
+        t: Any = ca.SX.sym("t")
+        Rs = [ca.SX.sym("R", 3, 3) for _ in range(self.n_th // 3)]
+        theta = ca.SX.sym("theta", self.n_th)
+        try:
+            F = self._rhs(t, y, u, Rs)
+            others = [self._theta_rate(theta, y)] if self.n_th else []
+            for c, kind, plans in self._constraints:
+                q, nu = self._casadi_qv(plans, y, Rs)
+                if kind == "inequality":
+                    others.append(parts.inequality_value(c, q, nu, t))
+                else:
+                    others.append(parts.equality_residual(c, q, nu, t))
+            if self.cost is not None:
+                q, nu = self._casadi_qv(self._plans, y, Rs)
+                us = tuple(u[p.u : p.u + p.body.dof] for p in self._plans)
+                others.append(parts._as_column(self.cost(t, q, nu, us), "cost", 1))
+        except (DefinitionError, RuntimeError, TypeError, ValueError, NotImplementedError):
+            return np.zeros(0, dtype=int), np.zeros(0, dtype=int)  # not analysed: none
+        final = self._final_y
+        states = {i for i in range(n_y) if self.y0[i] == 0.0 and final.get(i, 0.0) == 0.0}
+        controls = {i for i in range(n_u) if self.u_lower[i] <= 0.0 <= self.u_upper[i]}
+        rest = ca.vertcat(*others) if others else ca.SX(0, 1)
+        while True:
+            zs, zu = sorted(states), sorted(controls)
+            Z = ca.vertcat(*[y[i] for i in zs], *[u[i] for i in zu])
+            at_zero = ca.substitute(F, Z, ca.SX.zeros(Z.shape[0])) if zs or zu else F
+            drop_s = {i for i in zs if not at_zero[i].is_zero()}
+            # a state outside Z, or anything else, that depends on a component of Z
+            needed = ca.vertcat(*[F[i] for i in range(n_y) if i not in states], rest)
+            used = np.zeros(n_y + n_u, dtype=bool)
+            if needed.shape[0]:
+                pattern = ca.jacobian_sparsity(needed, ca.vertcat(y, u))
+                used[np.unique(np.asarray(pattern.get_col(), dtype=int))] = True
+            drop_s |= {i for i in zs if used[i]}
+            drop_u = {i for i in zu if used[n_y + i]}
+            if self.cost is None:  # uᵀM⁻¹u: no cross term between Z and the other controls
+                outside = [j for j in range(n_u) if j not in controls]
+                drop_u |= {i for i in zu if np.any(self._M_inv[i, outside] != 0.0)}
+            if not drop_s and not drop_u:
+                return np.array(zs, dtype=int), np.array(zu, dtype=int)
+            states -= drop_s
+            controls -= drop_u
 
     def _casadi_qv(self, plans: Sequence[_BodyPlan], y: Any, Rs: Sequence[Any]) -> Any:
         import casadi as ca
@@ -854,6 +936,14 @@ class _Transcription:
             np.arange(1, N - 1 if all(pb._final_fixes(p) for p in plans) else N)
             for _, _, plans in pb._constraints
         ]
+        self.idle_states, self.idle_controls = (
+            pb.idle
+            if pb.eliminate_idle
+            else (
+                np.zeros(0, dtype=int),
+                np.zeros(0, dtype=int),
+            )
+        )
         self.bounds = self._simple_bounds()
         # grad_f, jac_g and hess_lag assembled from the blocks' (mapped build), else CasADi's
         self.derivatives: dict[str, Any] = {}
@@ -886,6 +976,10 @@ class _Transcription:
         lbx[phi0 : phi0 + nth] = ubx[phi0 : phi0 + nth] = 0.0
         lbx[ny * N : th0] = np.tile(pb.u_lower, N)
         ubx[ny * N : th0] = np.tile(pb.u_upper, N)
+        nodes = np.arange(N)[:, None]
+        for base, size, idle in ((0, ny, self.idle_states), (ny * N, nu_, self.idle_controls)):
+            held = (base + nodes * size + idle[None, :]).reshape(-1)
+            lbx[held] = ubx[held] = 0.0
         if self.free:
             assert pb.tf_bounds is not None
             lbx[-1], ubx[-1] = pb.tf_bounds
@@ -1000,6 +1094,9 @@ class _Transcription:
         h = tk[p] - tk[0]
         A = ca.DM(0.5 * np.asarray(lgl_integration_matrix(p))[1:].T)  # (p+1) × p
         dyn = Yk[:, 1:] - ca.repmat(Yk[:, 0], 1, p) - h * (ca.horzcat(*Fs) @ A)
+        idle = self.idle_states
+        if idle.size:  # states held at zero (OptimalControlProblem.idle): no rows
+            dyn = dyn[[i for i in range(pb.n_y) if i not in set(idle.tolist())], :]
         res = [ca.vec(dyn)]
         if nth:
             rates = ca.horzcat(*[pb._theta_rate(thetas[j], Yk[:, j]) for j in range(p + 1)])
@@ -1049,6 +1146,10 @@ class _Transcription:
         Yk = ca.reshape(w[cut[1] : cut[2]], ny, p + 1)
         Uk = ca.reshape(w[cut[2] : cut[3]], nu_, p + 1)
         THk = ca.reshape(w[cut[3] : cut[4]], nth, p)
+        # components held at zero enter as zeros: no derivatives are formed for them
+        for M, idle in ((Yk, self.idle_states), (Uk, self.idle_controls)):
+            for i in idle.tolist():
+                M[i, :] = 0.0
         Rbar = ca.reshape(a[: 9 * nr], 3, 3 * nr)
         node = [a[9 * nr + j] for j in range(p + 1)]
         if self.free:
@@ -1408,22 +1509,21 @@ class _Transcription:
                     Yg[:, p.y + 3 : p.y + 6] = phi / (pb.tf - pb.t0)
         if nr:
             Rg[0] = np.array(pb.R0)  # the start is given
-        TH = np.zeros((pb.n_th, self.n_th_cols))
-        Rbar = np.zeros((mesh.n_elements, nr, 3, 3))
-        col = i0 = 0
-        for k, deg in enumerate(mesh.degrees):
-            if nr:
-                self.budget.check(f"computing the starting point, element {k}")
-            for b in range(nr):
-                Rbar[k, b] = _orthonormal(Rg[i0, b])
-            for j in range(1, deg + 1):
-                for b in range(nr):
-                    d = so3.log(_orthonormal(Rbar[k, b].T @ Rg[i0 + j, b]))
-                    TH[3 * b : 3 * b + 3, col + j - 1] = np.clip(
-                        d, -pb.max_element_rotation, pb.max_element_rotation
-                    )
-            col += deg
-            i0 += deg
+        # element k's reference R̄_k: the guess at its first node; θ at its other nodes:
+        # log(R̄_kᵀ R), all elements at once
+        starts = np.array([mesh.first_node(k) for k in range(mesh.n_elements)], dtype=int)
+        Rbar = np.zeros((mesh.n_elements, 0, 3, 3))
+        TH = np.zeros((0, self.n_th_cols))
+        if nr:
+            Rbar = _orthonormal(Rg[starts])  # (K, n_rigid, 3, 3)
+            owner = np.repeat(np.arange(mesh.n_elements), mesh.degrees)  # θ column → element
+            later = np.concatenate(
+                [starts[k] + np.arange(1, p + 1) for k, p in enumerate(mesh.degrees)]
+            )
+            self.budget.check("computing the starting point")
+            d = so3.log(_orthonormal(np.swapaxes(Rbar[owner], -1, -2) @ Rg[later]))
+            rot = pb.max_element_rotation
+            TH = np.clip(d, -rot, rot).reshape(-1, pb.n_th).T  # (n_th, Σp)
         x0 = np.concatenate(
             [
                 Yg.reshape(-1),
@@ -1692,6 +1792,8 @@ class _Transcription:
                 "n_variables": int(x.size),
                 "n_constraints": int(gval.size),
                 "t_final": float(times[-1]),
+                "idle_states": int(self.idle_states.size),
+                "idle_controls": int(self.idle_controls.size),
                 "warm_started": bool(warm_started),
             },
             _kkt=_KKTEvaluator(self, x, pbar, lam_g, lam_x),
@@ -1994,12 +2096,11 @@ def _dm(a: FloatArray) -> Any:
 
 
 def _orthonormal(R: FloatArray) -> FloatArray:
-    """The nearest rotation (a product of rotations drifts by rounding only)."""
+    """The nearest rotations (..., 3, 3) (a product of rotations drifts by rounding only)."""
     u, _, vt = np.linalg.svd(R)
+    flip = np.linalg.det(u @ vt) < 0
+    u[..., :, -1] *= np.where(flip, -1.0, 1.0)[..., None]
     out: FloatArray = u @ vt
-    if np.linalg.det(out) < 0:
-        u[:, -1] *= -1
-        out = u @ vt
     return out
 
 
