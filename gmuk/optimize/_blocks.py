@@ -87,11 +87,15 @@ def _assembled(
     columns = unique // n_rows
     colind = np.searchsorted(columns, np.arange(n_cols + 1))
     sp = ca.Sparsity(n_rows, n_cols, colind.tolist(), (unique % n_rows).tolist())
+    nonzeros = ca.vertcat(*values) if values else ca.MX(0, 1)
+    if unique.size == key.size:  # no entry shared: a permutation
+        order = np.empty(key.size, dtype=int)
+        order[position] = np.arange(key.size)
+        return ca.MX(sp, nonzeros[order.tolist()])
     # entry e of the values adds to nonzero position[e]: one nonzero per column
     summing = ca.DM(
         ca.Sparsity(unique.size, key.size, list(range(key.size + 1)), position.tolist()), 1.0
     )
-    nonzeros = ca.vertcat(*values) if values else ca.MX(0, 1)
     return ca.MX(sp, ca.densify(summing @ nonzeros))
 
 
