@@ -1493,40 +1493,40 @@ TIMINGS += [
     (CH6, "85 s on 2026-11-26", f"wall_time_s, {_MACHINE}"),
     (CH6, "(84.3 s", f"wall_time_s, 2026-11-25, {_MACHINE}"),
     (CMP, "``wall_time_s`` 5.5 s", f"2026-11-25, {_MACHINE}"),
-    # benchmarks/bench_optimize_peers.py, 2026-11-28, load 1.4 on 2 cores: docs/optimize.rst's
-    # "Speed" table and the lines under it
+    # benchmarks/bench_optimize_peers.py --repeat 11, 2026-11-28, load 1.0 on 2 cores:
+    # docs/optimize.rst's "Speed" table and the lines under it
     *[
-        (OPT, text, "benchmarks/bench_optimize_peers.py, 2026-11-28, load 1.4 on 2 cores")
+        (OPT, text, "benchmarks/bench_optimize_peers.py --repeat 11, 2026-11-28, load 1.0")
         for text in (
-            "- 0.177",
-            "- 0.196 (gmuk 0.90×)",
-            "- 0.074, 1-D (gmuk 2.40×)",
-            "- 0.203 (gmuk 0.87×)",
-            "- 0.232",
-            "- 0.281 (gmuk 0.83×)",
-            "- 0.099, 1-D (gmuk 2.36×)",
-            "- 0.292",
-            "- 0.312 (gmuk 0.93×)",
-            "- 0.110, attitude only (gmuk 2.66×)",
-            "gmuk 0.045 + 0.140",
-            "0.032 + 0.153",
-            "gmuk 0.150 + 0.142",
-            "0.136 + 0.176",
+            "- 0.077",
+            "- 0.081, 1-D (gmuk 0.94×)",
+            "- 0.191 (gmuk 0.40×)",
+            "- 0.220 (gmuk 0.35×)",
+            "- 0.134",
+            "- 0.156, 1-D (gmuk 0.86×)",
+            "- 0.331 (gmuk 0.41×)",
+            "- 0.115",
+            "- 0.125, attitude only (gmuk 0.91×)",
+            "- 0.355 (gmuk 0.32×)",
+            "gmuk 0.024 + 0.053",
+            "0.017 + 0.066",
+            "gmuk 0.060 + 0.053",
+            "0.073 + 0.054",
+            "gave gmuk 0.93×, 0.78× and 0.98×",
             "1e-15 relative on the SMD",
             "to 1.8e-9 on the slew",
             "objective is 1551.99 (−1.8 %)",
             "(1169.5)",
             "gmuk took 0.364 s",
             "0.794 s on the slew",
-            "gmuk is 2.4–2.7× slower",
         )
     ],
     # benchmarks/bench_optimize.py --table, 2026-11-28: the time columns of the uniform table
     *[
-        (OPT, f"- {text}", "benchmarks/bench_optimize.py --table, 2026-11-28, load 1.1")
+        (OPT, f"- {text}", "benchmarks/bench_optimize.py --table, 2026-11-28, load 1.0")
         for text in (
-            *("0.011", "0.014", "0.019", "0.028", "0.049", "0.107"),
-            *("0.02", "0.03", "0.04", "0.07", "0.14", "0.26", "0.76"),
+            *("0.009", "0.008", "0.011", "0.014", "0.021", "0.034"),
+            *("0.01", "0.02", "0.03", "0.06", "0.11", "0.24"),
         )
     ],
 ]
@@ -2070,8 +2070,8 @@ RUNS["optimize-slew"] = Run(
 _SLEW = {
     6: ("1.7556297585e-3", "1.0e-12", "6.0e-8"),
     12: ("1.7556297584e-3", "< 1e-13", "1.3e-9"),
-    24: ("1.7556297592e-3", "< 1e-13", "1.8e-9"),
-    48: ("1.7556297625e-3", "< 1e-13", "6.0e-9"),
+    24: ("1.7556297592e-3", "< 1e-13", "2.3e-9"),
+    48: ("1.7556297625e-3", "< 1e-13", "6.3e-9"),
 }
 for _n, (_objective, _final, _resim) in _SLEW.items():
     _near = f"   * - {_n}"
@@ -2092,10 +2092,10 @@ for _n, (_objective, _final, _resim) in _SLEW.items():
 TIMINGS += [
     *[
         (OPT, f"- {text}", "benchmarks/bench_optimize.py --slew-only, 2026-11-28")
-        for text in ("0.13", "0.17", "0.19", "0.30")
+        for text in ("0.06", "0.07", "0.08", "0.12")
     ],
     (OPT, "the 48-element slew below took 19.9 s, against 1.5 s for the", "2026-11-25, one script"),
-    (OPT, "0.30 s now, in the table", "benchmarks/bench_optimize.py --slew-only, 2026-11-28"),
+    (OPT, "0.12 s now, in the table", "benchmarks/bench_optimize.py --slew-only, 2026-11-28"),
 ]
 _R = "fn:apollo_range:"
 _add(
