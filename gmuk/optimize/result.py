@@ -177,10 +177,15 @@ class OptimalControlResult:
         IPOPT's iteration log, when the solve was asked for it (``log=True``).
     path : dict of str → PathConstraintResult
     timings : dict
-        "transcription_s" (building the NLP and the solver), "solve_s" (IPOPT), "total_s".
+        "transcription_s" (building the NLP and the solver), "solve_s" (IPOPT's call), of
+        it "evaluations_s" (the NLP's functions and derivatives) and "ipopt_s" (IPOPT's own
+        work), "total_s" (s).
     stats : dict
         "constraint_violation" (largest violation of the NLP's constraints),
-        "n_variables", "n_constraints".
+        "n_variables", "n_constraints", "t_final" (s; the optimum's with a free final
+        time), "idle_states" and "idle_controls" (components held at zero:
+        :attr:`OptimalControlProblem.idle`), "warm_started" (the solve started from the
+        guess's own NLP point and multipliers).
     refinement : list of RefinementStep or None
         The history of :meth:`OptimalControlProblem.solve_adaptive`.
     """
