@@ -12,6 +12,7 @@ The flow: parts (bodies, constraints, force models, controllers) → :class:`Sys
 import sys as _sys
 
 from gmuk import (
+    attitude,
     constraints,
     control,
     crosscheck,
@@ -111,6 +112,7 @@ __all__ = [
     "UniformRotation",
     "VirtualPairT2",
     "__version__",
+    "attitude",
     "check",
     "compile_loop",
     "constraints",
