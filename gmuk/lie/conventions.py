@@ -31,8 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray, as_array, check_rotation, check_se3
-from gmuk.lie import so3
+from gmuk import attitude
+from gmuk._validation import FloatArray, as_array, check_se3
 
 __all__ = [
     "from_basilisk",
@@ -48,135 +48,10 @@ __all__ = [
 ]
 
 
-def matrix_from_mrp(sigma_BN: Any) -> FloatArray:
-    """The rotation ``R_NB`` of the modified Rodrigues parameters ``σ_BN``.
-
-    ``R_NB = [BN]ᵀ`` with Schaub and Junkins's
-    ``[BN] = I + (8[σ̃]² − 4(1 − σ²)[σ̃]) / (1 + σ²)²`` (their Eq. 3.152), σ² = σᵀσ.
-    Any σ, shadow set or not, gives the same matrix as its shadow.
-
-    Parameters
-    ----------
-    sigma_BN : array_like (..., 3)
-        MRPs of B relative to N (dimensionless).
-
-    Returns
-    -------
-    ndarray (..., 3, 3)
-        ``R_NB``: maps body components to N components.
-    """
-    s = as_array(sigma_BN, (3,), "sigma_BN")
-    S = so3.hat(s)
-    s2 = np.einsum("...i,...i->...", s, s)[..., None, None]
-    return np.eye(3) + (8.0 * S @ S + 4.0 * (1.0 - s2) * S) / (1.0 + s2) ** 2
-
-
-def _quaternion(R: FloatArray) -> FloatArray:
-    """Unit quaternion (w, x, y, z), w ≥ 0, of rotation matrices (..., 3, 3) (Shepperd's
-    method: the largest of 4w², 4x², 4y², 4z² chooses the formula, for accuracy)."""
-    t = np.trace(R, axis1=-2, axis2=-1)
-    d = np.stack([t, R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]], axis=-1)
-    k = np.argmax(d, axis=-1)
-    r = R
-    # the four candidate formulas, each scaled by 4·(its own largest component)
-    cand = np.stack(
-        [
-            np.stack(
-                [
-                    1 + t,
-                    r[..., 2, 1] - r[..., 1, 2],
-                    r[..., 0, 2] - r[..., 2, 0],
-                    r[..., 1, 0] - r[..., 0, 1],
-                ],
-                axis=-1,
-            ),
-            np.stack(
-                [
-                    r[..., 2, 1] - r[..., 1, 2],
-                    1 + 2 * r[..., 0, 0] - t,
-                    r[..., 0, 1] + r[..., 1, 0],
-                    r[..., 0, 2] + r[..., 2, 0],
-                ],
-                axis=-1,
-            ),
-            np.stack(
-                [
-                    r[..., 0, 2] - r[..., 2, 0],
-                    r[..., 0, 1] + r[..., 1, 0],
-                    1 + 2 * r[..., 1, 1] - t,
-                    r[..., 1, 2] + r[..., 2, 1],
-                ],
-                axis=-1,
-            ),
-            np.stack(
-                [
-                    r[..., 1, 0] - r[..., 0, 1],
-                    r[..., 0, 2] + r[..., 2, 0],
-                    r[..., 1, 2] + r[..., 2, 1],
-                    1 + 2 * r[..., 2, 2] - t,
-                ],
-                axis=-1,
-            ),
-        ],
-        axis=-2,
-    )
-    q = np.take_along_axis(cand, k[..., None, None], axis=-2)[..., 0, :]
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    return np.where(q[..., :1] < 0, -q, q)
-
-
-def mrp_from_matrix(R_NB: Any) -> FloatArray:
-    """The modified Rodrigues parameters ``σ_BN`` of ``R_NB``, the set with ``|σ| ≤ 1``.
-
-    ``σ = ê tan(Φ/4)`` for the principal rotation of B relative to N by Φ ∈ [0, π] about ê;
-    with the quaternion ``(q₀, q)`` of that rotation (q₀ ≥ 0), ``σ = q / (1 + q₀)``. At
-    Φ = π both σ and its shadow have ``|σ| = 1``; either may be returned.
-
-    Parameters
-    ----------
-    R_NB : array_like (..., 3, 3)
-        Rotation matrices (checked: RᵀR = I, det +1).
-
-    Returns
-    -------
-    ndarray (..., 3)
-        σ_BN (dimensionless), ``|σ| ≤ 1``.
-
-    Raises
-    ------
-    gmuk.errors.NotOnGroupError
-        ``R_NB`` is not a rotation matrix.
-    """
-    R = check_rotation(R_NB, "R_NB")
-    q = _quaternion(R)
-    return q[..., 1:] / (1.0 + q[..., :1])
-
-
-def mrp_shadow(sigma: Any) -> FloatArray:
-    """The shadow set ``σˢ = −σ / |σ|²`` of MRPs: the same attitude, the other way round
-    (principal angle Φ − 2π). σ = 0 has no shadow (it is at infinity).
-
-    Parameters
-    ----------
-    sigma : array_like (..., 3)
-        MRPs (dimensionless), each nonzero.
-
-    Returns
-    -------
-    ndarray (..., 3)
-
-    Raises
-    ------
-    gmuk.errors.DomainError
-        Some σ is zero.
-    """
-    from gmuk.errors import DomainError
-
-    s = as_array(sigma, (3,), "sigma")
-    s2 = np.einsum("...i,...i->...", s, s)[..., None]
-    if np.any(s2 == 0.0):
-        raise DomainError("sigma = 0 (no rotation) has no shadow set: it would be at infinity")
-    return -s / s2
+# MRPs are defined once, in gmuk.attitude; these are their names here (kept for users).
+matrix_from_mrp = attitude.R_NB_from_mrp
+mrp_from_matrix = attitude.mrp_from_R_NB
+mrp_shadow = attitude.mrp_shadow
 
 
 def to_basilisk(g_NB: Any, V_B: Any) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
