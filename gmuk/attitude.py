@@ -52,6 +52,7 @@ __all__ = [
     "R_NB_from_euler",
     "R_NB_from_mrp",
     "R_NB_from_quaternion",
+    "axis_rotation",
     "dcm_BN_from_R_NB",
     "euler_from_R_NB",
     "mrp_from_R_NB",
@@ -547,8 +548,25 @@ def _atan2(y: FloatArray, x: FloatArray) -> FloatArray:
     return np.where(a <= -np.pi, np.pi, a)
 
 
-def _axis_rotation(axis: int, a: FloatArray) -> FloatArray:
-    """Active rotation by ``a`` (rad) about coordinate axis ``axis``."""
+def axis_rotation(axis: int, angle: Any) -> FloatArray:
+    """The rotation ``R_NB`` of a body turned by ``angle`` about coordinate axis ``axis``
+    (0, 1, 2 for x, y, z), right-handed: the elementary rotation of the Euler sequences
+    (Schaub & Junkins's ``M_i(angle)ᵀ``).
+
+    Parameters
+    ----------
+    axis : int
+        0, 1 or 2.
+    angle : float or ndarray, shape (...)
+        Rotation angle (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+    """
+    if not isinstance(axis, (int, np.integer)) or isinstance(axis, bool) or axis not in (0, 1, 2):
+        raise DefinitionError(f"axis must be 0, 1 or 2 (x, y, z); got {axis!r:.40}")
+    a = np.asarray(angle, dtype=float)
     c, s = np.cos(a), np.sin(a)
     R = np.zeros((*np.shape(a), 3, 3))
     i, j = (axis + 1) % 3, (axis + 2) % 3
@@ -595,9 +613,7 @@ def R_NB_from_euler(angles: Any, sequence: str) -> FloatArray:
     """
     i, j, k = _sequence(sequence)
     a = as_array(angles, (3,), "angles")
-    return (
-        _axis_rotation(i, a[..., 0]) @ _axis_rotation(j, a[..., 1]) @ _axis_rotation(k, a[..., 2])
-    )
+    return axis_rotation(i, a[..., 0]) @ axis_rotation(j, a[..., 1]) @ axis_rotation(k, a[..., 2])
 
 
 def euler_from_R_NB(R_NB: Any, sequence: str) -> FloatArray:
@@ -649,10 +665,10 @@ def euler_from_R_NB(R_NB: Any, sequence: str) -> FloatArray:
         beta = np.arctan2(sin_b, R[..., i, i])
         alpha_regular = _atan2(R[..., j, i], -eps * R[..., m, i])
         regular = sin_b > _GIMBAL_TOL
-    Rb_T = np.swapaxes(_axis_rotation(j, beta), -1, -2)
+    Rb_T = np.swapaxes(axis_rotation(j, beta), -1, -2)
     # At gimbal lock, γ = 0 and R = R_A(α) R_B(β): α from R R_B(β)ᵀ.
     alpha_lock = _axis_angle(i, R @ Rb_T)
     alpha = np.where(regular, alpha_regular, alpha_lock)
-    M = Rb_T @ np.swapaxes(_axis_rotation(i, alpha), -1, -2) @ R
+    M = Rb_T @ np.swapaxes(axis_rotation(i, alpha), -1, -2) @ R
     gamma = np.where(regular, _axis_angle(k, M), 0.0)
     return np.stack([alpha, beta, gamma], axis=-1)

@@ -355,3 +355,18 @@ def test_nearly_unit_quaternions_are_normalised():
     q = np.array([1.0 + 5e-7, 0.0, 0.0, 0.0])
     np.testing.assert_array_equal(at.R_NB_from_quaternion(q, scalar="first"), np.eye(3))
     assert at.R_NB_from_quaternion(np.array([[1, 0, 0, 0]]), scalar="last").dtype == np.float64
+
+
+@pytest.mark.parametrize("axis", [3, -1, 1.0, True, "z"])
+def test_axis_rotation_takes_only_the_axes_0_1_2(axis):
+    with pytest.raises(DefinitionError, match="axis must be 0, 1 or 2"):
+        at.axis_rotation(axis, 0.3)
+
+
+def test_axis_rotation_is_the_exponential_of_the_axis():
+    angles = np.array([-2.0, 0.0, 0.4, 3.0])
+    for axis in range(3):
+        e = np.zeros(3)
+        e[axis] = 1.0
+        expected = so3.exp(angles[:, None] * e)
+        np.testing.assert_allclose(at.axis_rotation(axis, angles), expected, atol=1e-15)

@@ -23,6 +23,7 @@ from typing import Any, Literal
 import numpy as np
 
 from gmuk._validation import FloatArray, as_array, check_rotation
+from gmuk.attitude import axis_rotation
 from gmuk.errors import EulerSequenceError
 
 __all__ = ["SEQUENCES", "from_matrix", "to_matrix"]
@@ -46,18 +47,6 @@ def _atan2(y: FloatArray, x: FloatArray) -> FloatArray:
     return np.where(a <= -np.pi, np.pi, a)
 
 
-def _axis_rotation(axis: int, a: FloatArray) -> FloatArray:
-    c, s = np.cos(a), np.sin(a)
-    R = np.zeros((*a.shape, 3, 3))
-    i, j = (axis + 1) % 3, (axis + 2) % 3
-    R[..., axis, axis] = 1.0
-    R[..., i, i] = c
-    R[..., j, j] = c
-    R[..., j, i] = s
-    R[..., i, j] = -s
-    return R
-
-
 def to_matrix(angles: Any, seq: Sequence = "321") -> FloatArray:
     """Rotation matrix ``R_NB`` from Euler angles.
 
@@ -75,9 +64,9 @@ def to_matrix(angles: Any, seq: Sequence = "321") -> FloatArray:
     a = as_array(angles, (3,), "angles")
     axes = [int(ch) - 1 for ch in seq]
     return (
-        _axis_rotation(axes[0], a[..., 0])
-        @ _axis_rotation(axes[1], a[..., 1])
-        @ _axis_rotation(axes[2], a[..., 2])
+        axis_rotation(axes[0], a[..., 0])
+        @ axis_rotation(axes[1], a[..., 1])
+        @ axis_rotation(axes[2], a[..., 2])
     )
 
 
@@ -110,7 +99,7 @@ def from_matrix(R: Any, seq: Sequence = "321") -> FloatArray:
         # φ from the residual R₁(φ) = (R₃(ψ) R₂(θ))ᵀ R, not from row 3 of R alone: near
         # gimbal lock ψ and φ are each ill-conditioned (error ε/cos θ) and only this keeps
         # the three angles consistent, so that they reproduce R to round-off.
-        M = np.swapaxes(_axis_rotation(2, psi) @ _axis_rotation(1, th), -1, -2) @ R
+        M = np.swapaxes(axis_rotation(2, psi) @ axis_rotation(1, th), -1, -2) @ R
         phi = np.where(regular, _atan2(M[..., 2, 1], M[..., 1, 1]), 0.0)
         return np.stack([psi, th, phi], axis=-1)
     sin_i = np.hypot(R[..., 0, 2], R[..., 1, 2])
@@ -120,6 +109,6 @@ def from_matrix(R: Any, seq: Sequence = "321") -> FloatArray:
         regular, _atan2(R[..., 0, 2], -R[..., 1, 2]), _atan2(R[..., 1, 0], R[..., 0, 0])
     )
     # ω from the residual R₃(ω) = (R₃(Ω) R₁(i))ᵀ R (see the 3-2-1 case).
-    M = np.swapaxes(_axis_rotation(2, raan) @ _axis_rotation(0, inc), -1, -2) @ R
+    M = np.swapaxes(axis_rotation(2, raan) @ axis_rotation(0, inc), -1, -2) @ R
     argp = np.where(regular, _atan2(M[..., 1, 0], M[..., 0, 0]), 0.0)
     return np.stack([raan, inc, argp], axis=-1)
