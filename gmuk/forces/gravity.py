@@ -177,7 +177,7 @@ class GravityGradient(ForceModel):
     """
 
     _kernel = staticmethod(gravity_gradient_load)
-    _forms = Forms(compiled=True, symbolic="no CasADi form of Eq. 23 is written yet")
+    _forms = Forms(compiled=True, symbolic=True)
 
     def __init__(
         self, mu: float, *, bodies: Sequence[Body | str] | None = None, modeled: bool = True
@@ -196,6 +196,26 @@ class GravityGradient(ForceModel):
 
     def _kernel_params(self, body: Body) -> tuple[tuple[float, ...], None]:
         return (self.mu,), None
+
+    def casadi_force(self, t: Any, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force` (CasADi, 3×1): the point-mass force."""
+        return PointMassGravity.casadi_force(self, t, r_N, v_N, body)  # type: ignore[arg-type]
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` (CasADi, 6×1): Eq. 23 as
+        :func:`gravity_gradient_wrench` writes it, with r_B = Rᵀ r_N,
+        ``L = 3μ/r⁵ r_B × J r_B`` and
+        ``f = −μm/r³ (r_B + 3/(m r²) (J r_B + ½(tr J − 5 r_Bᵀ J r_B / r²) r_B))``."""
+        ca = casadi()
+        J, m = ca.DM(body.inertia), body.mass
+        r_B = g_NB[:3, :3].T @ g_NB[:3, 3]
+        j = J @ r_B
+        r2 = ca.sumsqr(r_B)
+        rn = ca.sqrt(r2)
+        L = (3.0 * self.mu / (r2 * r2 * rn)) * ca.cross(r_B, j)
+        c = 0.5 * (float(np.trace(body.inertia)) - 5.0 * ca.dot(r_B, j) / r2)
+        f = (-self.mu * m / (r2 * rn)) * (r_B + (3.0 / (m * r2)) * (j + c * r_B))
+        return ca.vertcat(L, f)
 
 
 def _shipped_body(name: str, degree: int | None) -> CelestialBody:

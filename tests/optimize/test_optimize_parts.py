@@ -46,6 +46,7 @@ def _casadi_args(state, bodies):
         lambda a, b, c: gmuk.LinearSpringDamper(3.0, 0.4, anchor=[0.1, -0.2, 0.3]),
         lambda a, b, c: gmuk.UniformGravity(),
         lambda a, b, c: gmuk.PointMassGravity(3.986e14),
+        lambda a, b, c: gmuk.GravityGradient(3.986e14),
         lambda a, b, c: gmuk.AppliedWrench(
             a, lambda t: [t, 2.0, 3.0, -1.0, 0.5, t], frame="inertial"
         ),
