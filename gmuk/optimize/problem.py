@@ -1076,9 +1076,7 @@ class _Transcription:
 
         pb = self.problem
         nth, nr = pb.n_th, pb.n_th // 3
-        starts = [
-            Rbar[:, 3 * b : 3 * b + 3] @ _so3.exp_casadi(phi[3 * b : 3 * b + 3]) for b in range(nr)
-        ]
+        starts = _element_starts(Rbar, phi)
         thetas = [ca.SX.zeros(nth, 1)] + [THk[:, j] for j in range(p)]
         node_R = [starts] + [pb._attitudes(starts, thetas[j]) for j in range(1, p + 1)]
         Fs, Ls = [], []
@@ -1215,15 +1213,8 @@ class _Transcription:
             phi_a, th_a, phi_b = (ca.SX.sym(n, nth) for n in ("phi_a", "theta_a", "phi_b"))
             Ra, Rb = ca.SX.sym("Ra", 9 * nr), ca.SX.sym("Rb", 9 * nr)
 
-            def start(R: Any, ph: Any) -> list[Any]:
-                Rm = ca.reshape(R, 3, 3 * nr)
-                return [
-                    Rm[:, 3 * b : 3 * b + 3] @ _so3.exp_casadi(ph[3 * b : 3 * b + 3])
-                    for b in range(nr)
-                ]
-
-            end_a = pb._attitudes(start(Ra, phi_a), th_a)
-            start_b = start(Rb, phi_b)
+            end_a = pb._attitudes(_element_starts(ca.reshape(Ra, 3, 3 * nr), phi_a), th_a)
+            start_b = _element_starts(ca.reshape(Rb, 3, 3 * nr), phi_b)
             last = entries(o2, nth, cols_th[:, -1:])  # θ at each element's last node
             phis = entries(o3, nth, np.arange(K)[:, None])
             Rbars = ca.reshape(P, 9 * nr, K)
@@ -1231,10 +1222,7 @@ class _Transcription:
                 cont = ca.Function(
                     "continuity",
                     [ca.vertcat(phi_a, th_a, phi_b), ca.vertcat(Ra, Rb)],
-                    [
-                        ca.vertcat(*[_skew_vee(start_b[b].T @ end_a[b]) for b in range(nr)]),
-                        ca.SX(1, 1),
-                    ],
+                    [_continuity_rows(start_b, end_a), ca.SX(1, 1)],
                 )
                 blocks.append(
                     _blocks.Block(
@@ -1335,10 +1323,9 @@ class _Transcription:
         g_blocks = [dyn]
         if nr and K > 1:
             Ra, Rb = ca.SX.sym("Ra", 3, 3 * nr), ca.SX.sym("Rb", 3, 3 * nr)
-            rows = [
-                _skew_vee(Ra[:, 3 * b : 3 * b + 3].T @ Rb[:, 3 * b : 3 * b + 3]) for b in range(nr)
-            ]
-            cont = ca.Function("continuity", [Ra, Rb], [ca.vertcat(*rows)])
+            blocks3 = [slice(3 * b, 3 * b + 3) for b in range(nr)]
+            rows = _continuity_rows([Ra[:, c] for c in blocks3], [Rb[:, c] for c in blocks3])
+            cont = ca.Function("continuity", [Ra, Rb], [rows])
             g_blocks.append(
                 ca.vec(cont.map(K - 1)(R_start[:, 3 * nr :], R_end[:, : 3 * nr * (K - 1)]))
             )
@@ -2079,6 +2066,23 @@ def _time_build(problem: OptimalControlProblem, mesh: Mesh, n: int) -> tuple[flo
     solver(x0=np.clip(x0, tr.lbx, tr.ubx), p=p, lbx=tr.lbx, ubx=tr.ubx, lbg=tr.lbg, ubg=tr.ubg)
     end = time.perf_counter()
     return end - tic, end - mid
+
+
+def _element_starts(Rbar: Any, phi: Any) -> list[Any]:
+    """The attitudes at an element's start, ``R̄ exp(φ^)`` per rigid body: R̄ (3 × 3 n_rigid,
+    the reference attitudes side by side) and φ (3 n_rigid) CasADi."""
+    return [
+        Rbar[:, 3 * b : 3 * b + 3] @ _so3.exp_casadi(phi[3 * b : 3 * b + 3])
+        for b in range(phi.shape[0] // 3)
+    ]
+
+
+def _continuity_rows(starts_next: Sequence[Any], ends: Sequence[Any]) -> Any:
+    """The rows joining two elements, per rigid body ``vee(skew(R_{k+1}ᵀ R_k exp(θ_p)))``:
+    the next element's start attitudes and this element's end attitudes."""
+    import casadi as ca
+
+    return ca.vertcat(*[_skew_vee(a.T @ e) for a, e in zip(starts_next, ends, strict=True)])
 
 
 def _skew_vee(E: Any) -> Any:
