@@ -7,6 +7,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 import pytest
+from slew_problems import slew_problem
 
 import gmuk
 from gmuk.lie import so3
@@ -21,15 +22,7 @@ def _smd() -> tuple[OptimalControlProblem, Mesh]:
 
 
 def _slew() -> tuple[OptimalControlProblem, Mesh]:
-    body = gmuk.RigidBody(
-        "sat", 100.0, np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
-    )
-    system = gmuk.System([body])
-    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
-    gf = np.eye(4)
-    gf[:3, :3] = so3.exp(0.5 * np.pi * np.ones(3) / np.sqrt(3.0))
-    final = {"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
-    return OptimalControlProblem(system, state, 60.0, final=final), Mesh.uniform(0.0, 60.0, 3, 4)
+    return slew_problem(), Mesh.uniform(0.0, 60.0, 3, 4)
 
 
 def _two_bodies() -> tuple[OptimalControlProblem, Mesh]:

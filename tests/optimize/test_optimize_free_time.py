@@ -6,11 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from slew_problems import slew_problem
 
-import gmuk
 from gmuk.errors import DefinitionError
-from gmuk.lie import so3
-from gmuk.optimize import Mesh, OptimalControlProblem
+from gmuk.optimize import Mesh
 
 J_Z = 15.0  # kg m², the principal axis of the slew
 THETA = 0.5 * np.pi  # rad
@@ -18,13 +17,7 @@ TAU_MAX = 0.5  # N m
 
 
 def _slew(**options):
-    body = gmuk.RigidBody("sat", 100.0, np.diag([10.0, 12.0, J_Z]))
-    system = gmuk.System([body])
-    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
-    g_final = np.eye(4)
-    g_final[:3, :3] = so3.exp(np.array([0.0, 0.0, THETA]))
-    final = {"g": {"sat": g_final}, "V": {"sat": np.zeros(6)}}
-    return OptimalControlProblem(system, state, 20.0, final=final, **options)
+    return slew_problem(np.diag([10.0, 12.0, J_Z]), [0.0, 0.0, THETA], 20.0, **options)
 
 
 def _minimum_time():

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from slew_problems import slew_problem
 
 import gmuk
 from gmuk.errors import DefinitionError
-from gmuk.lie import so3
 from gmuk.optimize import Mesh, OptimalControlProblem
 from gmuk.scenarios import smd
 
@@ -40,19 +40,12 @@ def test_a_mass_moved_along_one_axis_is_solved_on_that_axis_with_the_same_optimu
 
 
 def test_the_translation_of_a_body_that_only_slews_is_held_at_zero():
-    J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
-    body = gmuk.RigidBody("sat", 100.0, J)
-    system = gmuk.System([body])
-    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
-    g_final = np.eye(4)
-    g_final[:3, :3] = so3.exp(0.5 * np.pi * np.ones(3) / np.sqrt(3.0))
-    final = {"g": {"sat": g_final}, "V": {"sat": np.zeros(6)}}
     mesh = Mesh.uniform(0.0, 60.0, 8, 4)
-    reduced = OptimalControlProblem(system, state, 60.0, final=final)
+    reduced = slew_problem()
     # r_N (0-2) and v_B (6-8); the body force f (controls 3-5)
     assert reduced.idle[0].tolist() == [0, 1, 2, 6, 7, 8]
     assert reduced.idle[1].tolist() == [3, 4, 5]
-    full = OptimalControlProblem(system, state, 60.0, final=final, eliminate_idle=False)
+    full = slew_problem(eliminate_idle=False)
     a, b = reduced.solve(mesh), full.solve(mesh)
     assert a.objective == pytest.approx(b.objective, rel=1e-9)
     np.testing.assert_allclose(a.R_NB, b.R_NB, atol=1e-8)

@@ -5,10 +5,11 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from slew_problems import GENERAL_INERTIA, slew_problem
 
 import gmuk
 from gmuk.lie import so3
-from gmuk.optimize import Mesh, OptimalControlProblem, _so3
+from gmuk.optimize import Mesh, _so3
 from gmuk.optimize.problem import _Transcription
 
 T = 60.0  # s
@@ -19,21 +20,18 @@ def _rotation_angles(R_a, R_b):
 
 
 def _slew(inertia, axis, n_elements, degree=3):
-    body = gmuk.RigidBody("sat", 100.0, inertia)
-    system = gmuk.System([body])
-    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
+    rotation = 0.5 * np.pi * np.asarray(axis) / np.linalg.norm(axis)
+    problem = slew_problem(inertia, rotation, T)
+    body = problem.system.bodies[0]
+    state = problem.system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
     gf = np.eye(4)
-    gf[:3, :3] = so3.exp(0.5 * np.pi * np.asarray(axis) / np.linalg.norm(axis))
-    problem = OptimalControlProblem(
-        system, state, T, final={"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
-    )
+    gf[:3, :3] = so3.exp(rotation)
     return body, state, gf, problem, problem.solve(Mesh.uniform(0.0, T, n_elements, degree))
 
 
 @functools.cache
 def _general_slew():
-    J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
-    return _slew(J, [1.0, 1.0, 1.0], 12, 4)
+    return _slew(GENERAL_INERTIA, [1.0, 1.0, 1.0], 12, 4)
 
 
 def test_principal_axis_slew_has_the_analytic_minimum_effort():
@@ -115,14 +113,10 @@ def test_the_unrolled_transcription_gives_the_mapped_optimum(monkeypatch):
 
 
 def test_a_slew_refines_from_its_previous_solution():
-    J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
-    body = gmuk.RigidBody("sat", 100.0, J)
-    system = gmuk.System([body])
-    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
+    rotation = [1.5, 1.5, 0.0]  # 122°: more than one element's chart bound
     gf = np.eye(4)
-    gf[:3, :3] = so3.exp([1.5, 1.5, 0.0])  # 122°: more than one element's chart bound
-    final = {"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
-    problem = OptimalControlProblem(system, state, T, final=final)
+    gf[:3, :3] = so3.exp(rotation)
+    problem = slew_problem(GENERAL_INERTIA, rotation, T)
     result = problem.solve_adaptive(Mesh.uniform(0.0, T, 2, 3), tol=1e-7)
     steps = result.refinement
     assert steps[-1].max_error <= 1e-7 and len(steps) >= 2
