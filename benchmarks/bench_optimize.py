@@ -30,6 +30,7 @@ import statistics
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "optimize"))
 
@@ -115,6 +116,24 @@ def table() -> None:
         )
 
 
+def slew_setup() -> tuple[Any, Any, dict[str, Any]]:
+    """docs/optimize.rst's slew, as the user builds it before timing starts: the System of
+    one free body "sat" (100 kg, J = [[10, 1, −0.5], [1, 12, 0.3], [−0.5, 0.3, 15]] kg·m²),
+    its State at rest at the identity, and the final conditions (at rest, turned 90° about
+    (1, 1, 1)/√3)."""
+    import numpy as np
+
+    import gmuk
+    from gmuk.lie import so3
+
+    J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
+    system = gmuk.System([gmuk.RigidBody("sat", 100.0, J)])
+    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
+    gf = np.eye(4)
+    gf[:3, :3] = so3.exp(0.5 * np.pi * np.ones(3) / np.sqrt(3.0))
+    return system, state, {"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
+
+
 def slew_rows(elements: tuple[int, ...] = (6, 12, 24, 48)) -> list[dict[str, float]]:
     """Minimum-effort rest-to-rest slew of one rigid body, 90° about (1, 1, 1)/√3 in 60 s,
     degree 4, on each number of ``elements``: per mesh the objective, the largest
@@ -127,13 +146,9 @@ def slew_rows(elements: tuple[int, ...] = (6, 12, 24, 48)) -> list[dict[str, flo
     import gmuk
     from gmuk.lie import so3
 
-    J = np.array([[10.0, 1.0, -0.5], [1.0, 12.0, 0.3], [-0.5, 0.3, 15.0]])
-    body = gmuk.RigidBody("sat", 100.0, J)
-    system = gmuk.System([body])
-    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
-    gf = np.eye(4)
-    gf[:3, :3] = so3.exp(0.5 * np.pi * np.ones(3) / np.sqrt(3.0))
-    final = {"g": {"sat": gf}, "V": {"sat": np.zeros(6)}}
+    system, state, final = slew_setup()
+    body = system.bodies[0]
+    gf = final["g"]["sat"]
     rows = []
     for n in elements:
         tic = time.perf_counter()

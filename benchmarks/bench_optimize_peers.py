@@ -54,15 +54,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from bench_optimize import slew_setup
 from gekko_smd import gekko_smd
-from hand_transcriptions import SLEW_INERTIA, SLEW_MASS, HandResult, slew_mapped, smd_mapped
+from hand_transcriptions import HandResult, slew_mapped, smd_mapped
 
-import gmuk
-from gmuk.lie import so3
 from gmuk.optimize import Mesh, OptimalControlProblem
 from gmuk.scenarios import smd
 
@@ -105,12 +102,7 @@ def gmuk_smd(n_elements: int, degree: int) -> Runner:
 
 def gmuk_slew(n_elements: int, degree: int) -> Runner:
     """gmuk on bench_optimize.slew_rows's slew (System, State and final state built once)."""
-    body = gmuk.RigidBody("sat", SLEW_MASS, SLEW_INERTIA)
-    system = gmuk.System([body])
-    state = system.state(g={"sat": np.eye(4)}, V={"sat": np.zeros(6)})
-    g_final = np.eye(4)
-    g_final[:3, :3] = so3.exp(0.5 * np.pi * np.ones(3) / np.sqrt(3.0))
-    final = {"g": {"sat": g_final}, "V": {"sat": np.zeros(6)}}
+    system, state, final = slew_setup()
 
     def run() -> Run:
         tic = time.perf_counter()
