@@ -46,6 +46,7 @@ from gmuk.control import Controller, MorseLyapunovController
 from gmuk.crosscheck import check
 from gmuk.dynamics import spatial_inertia
 from gmuk.engine import integrate, integrators, solvers, uk
+from gmuk.engine.events import AltitudeEvent, ApsisEvent, Event
 from gmuk.engine.integrate import compile_loop
 from gmuk.engine.solvers import UKSolver
 from gmuk.engine.system import Accelerations, System
@@ -64,14 +65,16 @@ from gmuk.forces import (
 from gmuk.gravity import SphericalHarmonicField
 from gmuk.reference import ReferenceState, ReferenceTrajectory
 from gmuk.state import Layout, State
-from gmuk.trajectory import BodyTrajectory, Trajectory, load_trajectory
+from gmuk.trajectory import BodyTrajectory, EventRecord, Trajectory, load_trajectory
 
 __version__ = "0.1.0"
 
 __all__ = [
     "INERTIAL",
     "Accelerations",
+    "AltitudeEvent",
     "AppliedWrench",
+    "ApsisEvent",
     "Baumgarte",
     "Body",
     "BodyKind",
@@ -81,6 +84,8 @@ __all__ = [
     "ConfigurationTrackingT2",
     "Constraint",
     "Controller",
+    "Event",
+    "EventRecord",
     "ForceModel",
     "GravityGradient",
     "HolonomicConstraint",

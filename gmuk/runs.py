@@ -32,8 +32,14 @@ checksum does not match (edited by hand or corrupted), a checkpoint of another s
 continue: a time ``t`` outside the span ``[t0, t_end]``, a step ``h`` that is not a finite
 positive number, an output index ``out_i`` outside ``[0, len(t_eval)]`` or not equal to the
 number of rows written (whose times must be ``t_eval[:out_i]``), rows after ``t``, ``complete``
-without ``t == t_end`` and status ``"success"``, a base pose or state of the wrong size or not
-finite, other bodies than the run's. Nothing is resumed silently wrong.
+without ``t == t_end`` and status ``"success"`` (or, status ``"terminated"``, a terminal event at
+``t`` that is the last row), a base pose or state of the wrong size or not finite, other bodies
+than the run's. Nothing is resumed silently wrong.
+
+Events (:mod:`gmuk.engine.events`) are part of a checkpoint: those located up to its step are
+in its trajectory (``traj.events``, covered by the checksum) and a resumed run appends the later
+ones, each once; the events (their class, name, direction and terminal flag) are in the
+fingerprint, so a run resumed with other events is refused.
 """
 
 from __future__ import annotations
@@ -86,6 +92,8 @@ class RunControl:
     stop_requested: bool = False
     calls: int = 0
     written: list[Path] = field(default_factory=list)
+    #: Events (gmuk.Event) added to every simulation of the run (``gmuk run --stop-at``).
+    events: tuple[Any, ...] = ()
 
     def request_stop(self) -> None:
         """Ask the running simulation (and every later one) to stop at its next step."""
@@ -112,7 +120,11 @@ def current() -> RunControl | None:
 
 @contextmanager
 def run_control(
-    checkpoint_dir: str | Path | None = None, *, every_s: float = 60.0, resume: bool = False
+    checkpoint_dir: str | Path | None = None,
+    *,
+    every_s: float = 60.0,
+    resume: bool = False,
+    events: Any = None,
 ) -> Iterator[RunControl]:
     """Stop requests, periodic checkpoints and resuming for the simulations run inside.
 
@@ -124,13 +136,18 @@ def run_control(
         Wall-time interval between checkpoints (s), > 0.
     resume : bool
         Use the checkpoints found in ``checkpoint_dir``.
+    events : Event or sequence of Event, optional
+        Events (:class:`gmuk.Event`) added to the events of every simulation inside (a
+        checkpoint records them in its fingerprint: resume with the same ones).
     """
+    from gmuk.engine.events import check_events
+
     every = real_number(every_s, "every_s", positive=True, allow_inf=True)
     folder = None
     if checkpoint_dir is not None:
         folder = Path(checkpoint_dir)
         folder.mkdir(parents=True, exist_ok=True)
-    control = RunControl(folder, every, bool(resume))
+    control = RunControl(folder, every, bool(resume), events=check_events(events))
     token = _CURRENT.set(control)
     try:
         yield control
@@ -213,6 +230,10 @@ def checksum(traj: Trajectory, record: dict[str, Any]) -> str:
         "bodies": [list(traj.body_names), list(traj.body_kinds), list(traj.body_dofs)],
         "stats": {k: v for k, v in traj.stats.items() if k != "checkpoint"},
     }
+    if traj.events:  # as saved (gmuk.trajectory._event_meta), states included
+        from gmuk.trajectory import _event_meta
+
+        meta["events"] = [_event_meta(e) for e in traj.events]
     # as the file holds it: JSON (tuples become lists, keys strings), then in canonical order
     text = json.dumps(json.loads(json.dumps(meta, default=str)), sort_keys=True)
     h = hashlib.sha256(text.encode())
@@ -319,8 +340,11 @@ def _check_record(path: Path, traj: Trajectory, record: dict[str, Any], expected
         values = record[key]
         if not (isinstance(values, list) and all(_is_real(v) for v in values)):
             raise bad(f"{key} must be a list of finite numbers")
-    if complete != (traj.status == "success"):
+    terminated = traj.status == "terminated"
+    if complete != (traj.status in ("success", "terminated")):
         raise bad(f"complete is {complete} but the trajectory's status is {traj.status!r}")
+    if terminated and not (traj.events and traj.events[-1].terminal and traj.events[-1].t == t):
+        raise bad(f"status 'terminated' but no terminal event at t = {t!r} s")
     times = np.asarray(traj.t, dtype=float)
     if times.size > 1 and np.any(np.diff(times) < 0):
         raise bad("the checkpoint's output times run backwards")
@@ -329,7 +353,7 @@ def _check_record(path: Path, traj: Trajectory, record: dict[str, Any], expected
     t0, t_end = expected.t0, expected.t_end
     if not t0 <= t <= t_end:
         raise bad(f"t = {t!r} s is outside the run's span [{t0!r}, {t_end!r}] s")
-    if complete and t != t_end:
+    if complete and t != t_end and not terminated:
         raise bad(f"complete is true but t = {t!r} s, not the end of the span {t_end!r} s")
     bodies = (tuple(traj.body_names), tuple(traj.body_kinds), tuple(traj.body_dofs))
     if bodies != expected.bodies:
@@ -351,6 +375,10 @@ def _check_record(path: Path, traj: Trajectory, record: dict[str, Any], expected
         return
     if out_i > outs.size:
         raise bad(f"out_i = {out_i} is beyond the run's {outs.size} output times")
+    if terminated:  # the outputs before the terminal event, then the event's state at t
+        if rows != out_i + 1 or not np.array_equal(times[:-1], outs[:out_i]) or times[-1] != t:
+            raise bad("its rows are not the output times before the terminal event and t")
+        return
     if rows != out_i or not np.array_equal(times, outs[:out_i]):
         raise bad(
             f"out_i = {out_i} but the checkpoint holds {rows} rows"

@@ -19,7 +19,7 @@ import zipfile
 import zlib
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +31,7 @@ from gmuk.errors import DefinitionError, FileFormatError
 from gmuk.lie import euler, so3
 from gmuk.state import Layout, State
 
-__all__ = ["BodyTrajectory", "Trajectory", "load_trajectory"]
+__all__ = ["BodyTrajectory", "EventRecord", "Trajectory", "load_trajectory"]
 
 #: The version of the ``.npz`` format :meth:`Trajectory.save` writes. 2 added the ``r_N`` and
 #: ``v_N`` copies of the point masses' states; :func:`load_trajectory` reads 1 and 2.
@@ -52,6 +52,42 @@ _ARRAYS = (
     "residual",
     "rank",
 )
+
+
+@dataclass(frozen=True, eq=False)
+class EventRecord:
+    """One located event of a run (:class:`gmuk.Event`, :func:`gmuk.engine.integrate.simulate`).
+
+    Attributes
+    ----------
+    name : str
+        The event's name.
+    t : float
+        The crossing time (s), located to 1e-13 s (or 4 ε |t|) on the step's continuous
+        extension.
+    direction : int
+        +1: the function rose through zero; -1: it fell.
+    terminal : bool
+        Whether the event ended the run (then its state is the trajectory's last output).
+    state : State
+        The state at ``t`` (from the step's continuous extension).
+    """
+
+    name: str
+    t: float
+    direction: int
+    terminal: bool
+    state: State
+
+    def to_dict(self) -> dict[str, Any]:
+        """The event without its state, as JSON-ready values (``summary.json``)."""
+        return {"name": self.name, "t": self.t, "direction": self.direction,
+                "terminal": self.terminal}  # fmt: skip
+
+    def __repr__(self) -> str:
+        kind = "terminal" if self.terminal else "recorded"
+        way = "rising" if self.direction > 0 else "falling"
+        return f"EventRecord({self.name!r}, t={self.t!r} s, {way}, {kind})"
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -85,15 +121,19 @@ class Trajectory:
         Rank of A (−1 where not computed).
     body_names, body_kinds : tuple of str
     body_dofs : tuple of int
-    status : {"success", "drifted", "interrupted", "failed"}
-        "drifted": the run completed its span but a constraint drifted off past
-        ``drift_tol`` (:func:`gmuk.engine.integrate.simulate`); the message says which and when.
+    status : {"success", "terminated", "drifted", "interrupted", "failed"}
+        "terminated": a terminal event ended the run (the last of ``events``); "drifted":
+        the run completed its span but a constraint drifted off past ``drift_tol``
+        (:func:`gmuk.engine.integrate.simulate`); the message says which and when.
     message : str
     stats : dict
         ``n_rhs`` (right-hand-side evaluations), ``n_steps``, ``n_rejected``, ``method``;
         from :func:`gmuk.engine.integrate.simulate` also ``drifted`` (bool) and
         ``constraint_violation`` (the constraint check: largest residuals, tolerance, one
         entry per constraint).
+    events : tuple of EventRecord
+        The events located during the run (:class:`gmuk.Event`), in time order; a
+        terminal one is last.
     """
 
     t: FloatArray
@@ -116,6 +156,7 @@ class Trajectory:
     status: str = "success"
     message: str = ""
     stats: dict[str, Any] = field(default_factory=dict)
+    events: tuple[EventRecord, ...] = ()
 
     @property
     def layout(self) -> Layout:
@@ -125,9 +166,10 @@ class Trajectory:
 
     @property
     def success(self) -> bool:
-        """Whether the run reached the end of its time span on its constraints (status
-        "success": not "drifted", "interrupted" or "failed")."""
-        return self.status == "success"
+        """Whether the run ended as asked on its constraints: at the end of its time span
+        (status "success") or at a terminal event ("terminated"); not "drifted",
+        "interrupted" or "failed"."""
+        return self.status in ("success", "terminated")
 
     def __len__(self) -> int:
         return int(self.t.shape[0])
@@ -192,6 +234,14 @@ class Trajectory:
             if "n_rhs" in self.stats:
                 steps += f", {self.stats['n_rhs']} evaluations of the dynamics"
             row("Steps", steps)
+        if self.events:
+            names: dict[str, int] = {}
+            for e in self.events:
+                names[e.name] = names.get(e.name, 0) + 1
+            listed = ", ".join(f"{k} ×{v}" if v > 1 else k for k, v in names.items())
+            last = self.events[-1]
+            end = f"; ended by {last.name!r} at t = {last.t:.9g} s" if last.terminal else ""
+            row("Events", f"{len(self.events)} ({listed}){end}")
         if self.z.shape[1]:
             row("Controllers", f"{self.z.shape[1]} internal states (z)")
         nbytes = sum(getattr(self, k).nbytes for k in _ARRAYS)
@@ -275,6 +325,8 @@ class Trajectory:
             "message": self.message,
             "stats": self.stats,
         }
+        if self.events:
+            meta["events"] = [_event_meta(e) for e in self.events]
         arrays = {k: getattr(self, k) for k in _ARRAYS}
         # Convenience copies for readers without gmuk: point masses as (N, n_point, 3).
         arrays["r_N"], arrays["v_N"] = self.r_N, self.v_N
@@ -320,6 +372,13 @@ class Trajectory:
         path = Path(path)
         np.savetxt(path, np.hstack(cols), delimiter=",", header=",".join(header), comments="")
         return path
+
+
+def _event_meta(event: EventRecord) -> dict[str, Any]:
+    """An event as the file's metadata holds it: JSON floats round-trip exactly."""
+    st = event.state
+    state = {k: np.asarray(getattr(st, k)).tolist() for k in ("g", "V", "x", "xdot", "z")}
+    return {**event.to_dict(), "state": state}
 
 
 def _brief(value: Any) -> str:
@@ -469,7 +528,7 @@ MAX_META_BYTES = 64 * 2**20
 POSE_TOL = 1e-6
 #: The values of :attr:`Trajectory.status` ("drifted" since gmuk's drift check; files
 #: written before it carry the other three and load as they are).
-STATUSES = ("success", "drifted", "interrupted", "failed")
+STATUSES = ("success", "terminated", "drifted", "interrupted", "failed")
 _DOFS = {"rigid": 6, "point": 3, "slack": 1}
 _META_KEYS = ("format_version", "body_names", "body_kinds", "body_dofs", "status", "message")
 _NPY_MAGIC = b"\x93NUMPY"
@@ -529,6 +588,10 @@ def load_trajectory(path: str | Path, *, max_bytes: int = MAX_BYTES) -> Trajecto
           ``rtol``, ``atol`` (finite ≥ 0), ``compiled``, ``drifted`` (bool),
           ``versions``, ``checkpoint`` or ``constraint_violation`` (objects) have the
           wrong type;
+        * *events* (``meta["events"]``, written when the run located any): not a list of
+          objects with a name, a finite time (not decreasing), a direction ±1, a terminal
+          flag (true for the last only, at the last output's time) and a finite state of
+          the trajectory's bodies, poses on SE(3) within :data:`POSE_TOL`;
         * *arrays*: shapes that disagree with the bodies or with each other; NaN or
           infinity; times ``t`` that do not strictly increase; poses whose rotation
           block is not a rotation (‖RᵀR − I‖ or abs(det R − 1) above :data:`POSE_TOL`, a
@@ -572,6 +635,8 @@ def load_trajectory(path: str | Path, *, max_bytes: int = MAX_BYTES) -> Trajecto
     arrays = _check_dtypes(members, path)
     traj = Trajectory(**arrays, **body, status=status, message=message, stats=stats)
     _check_consistent(traj, path)
+    if "events" in meta:
+        traj = replace(traj, events=_check_events(meta["events"], traj, path))
     _check_values(traj, path)
     _check_copies(traj, copies, version, path)
     return traj
@@ -776,6 +841,64 @@ def _check_meta(
     _check_stats(stats, path)
     body = {"body_names": tuple(names), "body_kinds": tuple(kinds), "body_dofs": tuple(dofs)}
     return version, body, status, message, stats
+
+
+def _check_events(raw: Any, traj: Trajectory, path: Path) -> tuple[EventRecord, ...]:
+    """The metadata's ``events`` as EventRecords: each a name, a finite time, a direction
+    ±1, a terminal flag and a state of the trajectory's bodies (poses checked as the arrays'
+    are); in time order, a terminal one last and at the last output's time."""
+
+    def bad(i: int, why: str) -> FileFormatError:
+        return FileFormatError(f"{path}: metadata events[{i}]: {why}")
+
+    if not isinstance(raw, list):
+        raise FileFormatError(f"{path}: metadata events must be a list; got {raw!r:.80}")
+    lay = traj.layout
+    shapes = {"g": (lay.n_rigid, 4, 4), "V": (lay.n_rigid, 6), "x": (lay.n_euclid,),
+              "xdot": (lay.n_euclid,), "z": (lay.n_control,)}  # fmt: skip
+    out: list[EventRecord] = []
+    for i, e in enumerate(raw):
+        keys = {"name", "t", "direction", "terminal", "state"}
+        if not isinstance(e, dict) or set(e) != keys:
+            raise bad(i, f"must be an object with keys {sorted(keys)}; got {e!r:.80}")
+        name, t, direction, terminal, st = (e[k] for k in ("name", "t", "direction",
+                                                           "terminal", "state"))  # fmt: skip
+        if not isinstance(name, str) or not name:
+            raise bad(i, f"name must be a non-empty string; got {name!r:.80}")
+        if not (isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t)):
+            raise bad(i, f"t must be a finite time (s); got {t!r:.80}")
+        if terminal is True and len(traj) and t != traj.t[-1]:
+            raise bad(i, f"a terminal event at t = {t!r} s must be the last output's time")
+        if out and t < out[-1].t:
+            raise bad(i, f"t = {t!r} s comes before the previous event's {out[-1].t!r} s")
+        if not _is_int(direction) or direction not in (-1, 1):
+            raise bad(i, f"direction must be -1 or 1; got {direction!r:.80}")
+        if not isinstance(terminal, bool) or (terminal and i != len(raw) - 1):
+            raise bad(i, f"terminal must be true or false, and true for the last event only; "
+                      f"got {terminal!r:.80}")  # fmt: skip
+        if not isinstance(st, dict) or set(st) != set(shapes):
+            raise bad(i, f"state must be an object with keys {sorted(shapes)}")
+        arrays = {}
+        for key, shape in shapes.items():
+            try:
+                a = np.array(st[key], dtype=np.float64)
+            except (TypeError, ValueError, OverflowError):
+                raise bad(i, f"state[{key!r}] is not an array of numbers") from None
+            if a.size == 0 and math.prod(shape) == 0:  # JSON keeps no shape of an empty list
+                a = a.reshape(shape)
+            if a.shape != shape or not np.isfinite(a).all():
+                raise bad(i, f"state[{key!r}] must be finite of shape {shape}; got {a.shape}")
+            arrays[key] = a
+        if lay.n_rigid:
+            R = arrays["g"][:, :3, :3]
+            off = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max()
+            row = np.abs(arrays["g"][:, 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max()
+            if off > POSE_TOL or row > POSE_TOL or np.abs(np.linalg.det(R) - 1).max() > POSE_TOL:
+                raise bad(i, "state['g'] holds a pose that is not on SE(3)")
+        state = State(float(t), arrays["g"], arrays["V"], arrays["x"], arrays["xdot"],
+                      arrays["z"], lay)  # fmt: skip
+        out.append(EventRecord(name, float(t), int(direction), terminal, state))
+    return tuple(out)
 
 
 def _check_stats(stats: Any, path: Path) -> None:

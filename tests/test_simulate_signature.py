@@ -15,7 +15,7 @@ from gmuk.engine import integrate
 
 OPTIONS = [
     "t_eval", "method", "rtol", "atol", "step", "first_step", "max_step", "max_steps",
-    "progress", "on_failure", "compiled", "drift_tol",
+    "progress", "on_failure", "compiled", "drift_tol", "events",
 ]  # fmt: skip
 
 

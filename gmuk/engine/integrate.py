@@ -40,6 +40,7 @@ from __future__ import annotations
 import sys
 import time
 import warnings
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -48,6 +49,7 @@ import numpy as np
 
 from gmuk import runs
 from gmuk._validation import FloatArray, real_number
+from gmuk.engine.events import XTOL, Event, check_events, event_value
 
 # The method classes and the registry, re-exported here for convenience.
 from gmuk.engine.integrators import DOP853 as DOP853
@@ -62,7 +64,7 @@ from gmuk.engine.integrators._base import label
 from gmuk.errors import DefinitionError, GmukError, GmukWarning, SimulationError
 from gmuk.lie import _kernels
 from gmuk.state import State
-from gmuk.trajectory import _ARRAYS, Trajectory
+from gmuk.trajectory import _ARRAYS, EventRecord, Trajectory
 
 if TYPE_CHECKING:
     from gmuk.engine.system import Accelerations, System
@@ -131,6 +133,8 @@ class _Recorder:
         self.blocks: list[dict[str, Any]] = []
         # The outputs of a resumed run's checkpoint, which come before the rows.
         self.prefix = prefix
+        # The events located so far (after the prefix's).
+        self.events: list[EventRecord] = []
 
     def add(self, state: State, acc: Accelerations | None = None) -> None:
         if acc is None:
@@ -181,6 +185,7 @@ class _Recorder:
         if len({blk["multipliers"].shape[1] for blk in blocks}) > 1:
             raise GmukError("the number of constraint rows changed during the run")
         joined = {name: np.concatenate([blk[name] for blk in blocks]) for name in _ARRAYS}
+        events = (*(self.prefix.events if self.prefix is not None else ()), *self.events)
         return Trajectory(
             **joined,
             body_names=lay.names,
@@ -189,6 +194,7 @@ class _Recorder:
             status=status,
             message=message,
             stats=stats,
+            events=events,
         )
 
 
@@ -235,6 +241,7 @@ def simulate(
     on_failure: str = "raise",
     compiled: bool | None = None,
     drift_tol: float | None = 1e-6,
+    events: Event | Sequence[Event] | None = None,
 ) -> Trajectory:
     """Integrate a System on SE(3)ⁿ × Rᵏ from ``state0`` over ``t_span``.
 
@@ -294,6 +301,16 @@ def simulate(
         ``traj.success`` is False) and a GmukWarning. None measures and records the
         violations without judging them (for runs that leave their constraint by design,
         e.g. under unmodeled forces).
+    events : Event or sequence of Event, optional
+        Functions of (t, state) whose sign changes are located (:mod:`gmuk.engine.events`;
+        docs/events.rst): after each accepted step, by Brent's method to 1e-13 s on the
+        step's continuous extension (DOP853's dense output; for DOPRI5 and RK4 a step of the
+        method from the step's start to each trial time). A recorded event goes into
+        ``traj.events`` and changes none of the trajectory's other numbers; the first
+        terminal one ends the run at its time, with its state as the last output and
+        ``status="terminated"``. The event functions are evaluated in Python at every step,
+        so the loop hands back each step (a few µs per step more than without events).
+        Inside :func:`gmuk.runs.run_control`, the control's ``events`` are added.
 
     Returns
     -------
@@ -301,11 +318,15 @@ def simulate(
         ``stats`` holds the method's name, the numbers of evaluations, steps and rejected
         steps, the versions of gmuk, numba and numpy that computed it, and the constraint
         check: ``stats["drifted"]`` (bool) and ``stats["constraint_violation"]`` (below).
+        With events, ``stats["n_event_rhs"]`` counts the evaluations spent locating them
+        (not in ``n_rhs``); ``traj.events`` holds them (:class:`gmuk.trajectory.EventRecord`).
 
     Raises
     ------
     DefinitionError
-        For an unknown method name (the message lists the registered ones) or bad arguments.
+        For an unknown method name (the message lists the registered ones) or bad arguments,
+        among them events that are not :class:`gmuk.Event` objects, share a name, or whose
+        function does not return one real number at the start (NonFiniteError for NaN).
     gmuk.runs.CheckpointError
         When resuming from a checkpoint written by another simulation.
 
@@ -365,6 +386,11 @@ def simulate(
         )
     _program.method_table(run.method)  # a method the loop cannot run: say so first
     control = runs.current()
+    found = check_events(events)
+    if control is not None and control.events:
+        found = check_events((*found, *control.events))
+    for event in found:  # a function that cannot be evaluated: said before the run
+        event_value(event, run.t0, run.state0)
     checkpoint = control.next_path() if control is not None else None
     prefix: Trajectory | None = None
     record: dict[str, Any] | None = None
@@ -379,6 +405,10 @@ def simulate(
             "first_step": run.first_step,
             "max_step": run.max_step,
         }
+        if found:  # (only then: the fingerprints of runs without events are unchanged)
+            settings["events"] = [
+                (type(e).__qualname__, e.name, e.direction, e.terminal) for e in found
+            ]
         fingerprint = runs.fingerprint(run.state0, settings, run.outs)
         if control is not None and control.resume and checkpoint.exists():
             prefix, record = runs.load(checkpoint, fingerprint)
@@ -386,13 +416,16 @@ def simulate(
                 return check_drift(system, prefix, drift_tol)
     packing = _Packing(system)
     rec = _Recorder(packing, prefix)
-    loop = _Loop(packing, run)
+    loop = _Loop(packing, run, found)
     loop.control, loop.checkpoint = control, checkpoint
     loop.fingerprint, loop.recorder = fingerprint, rec
     bar = _Progress(progress, run.t0, run.t1)
     status, message = "success", ""
     try:
         loop.run(rec, bar, resume=record)
+        if loop.terminal is not None:
+            status = "terminated"
+            message = f"terminal event {loop.terminal.name!r} at t = {loop.terminal.t:.15g} s"
     except _StopRequested:
         status, message = "interrupted", f"stopped on request at t = {loop.t:.9g} s"
     except KeyboardInterrupt:
@@ -681,10 +714,17 @@ class _Loop:
     #: Steps per chunk: a chunk is the longest a stop request waits.
     chunk = 256
 
-    def __init__(self, packing: _Packing, run: _Run) -> None:
+    def __init__(self, packing: _Packing, run: _Run, events: tuple[Event, ...] = ()) -> None:
         self.p = packing
         self.run_args = run
         self.method = run.method
+        # Events: the loop hands back every step (a chunk of one), whose end Python checks.
+        self.events = events
+        if events:
+            self.chunk = 1
+        self.terminal: EventRecord | None = None
+        self.n_event_rhs = 0
+        self.g_prev: list[float] = []  # the events' values at the last accepted step
         self.rtol, self.atol = run.rtol, run.atol
         self.t = run.t0
         self.n_steps = self.n_rejected = self.n_rhs = 0
@@ -697,7 +737,7 @@ class _Loop:
         self.at: tuple[FloatArray, FloatArray, float, int] | None = None  # Y, G0, h, out_i
 
     def stats(self) -> dict[str, Any]:
-        return {
+        stats = {
             "n_rhs": self.n_rhs,
             "n_steps": self.n_steps,
             "n_rejected": self.n_rejected,
@@ -707,6 +747,9 @@ class _Loop:
             "compiled": True,
             "versions": versions(),
         }
+        if self.events:
+            stats["n_event_rhs"] = self.n_event_rhs
+        return stats
 
     def save_checkpoint(self, traj: Trajectory | None = None) -> None:
         """Write the checkpoint (the trajectory so far and the last accepted step)."""
@@ -718,7 +761,7 @@ class _Loop:
             traj = self.recorder.build("interrupted", "checkpoint", self.stats())
         record = {
             "fingerprint": self.fingerprint,
-            "complete": traj.status == "success",
+            "complete": traj.status in ("success", "terminated"),
             "t": self.t,
             "h": h,
             "out_i": out_i,
@@ -810,13 +853,30 @@ class _Loop:
         f0, aux = np.empty(n), np.empty(prog.n_aux)
         cap = self.chunk + 1
         bufs = self._buffers(cap, n, p.layout.n_rigid, prog.n_aux)
+        if self.events:  # the events' values at the start (a resumed run: at its step)
+            start_state = state0 if resume is None else p.state(t, Y, G0)
+            self.g_prev = [event_value(e, t, start_state) for e in self.events]
         while True:
             ints[_compiled.I_WRITTEN] = 0
+            if self.events:  # the step's start, for locating events in it
+                begun = bool(ints[_compiled.I_STARTED])
+                start = (
+                    float(fs[_compiled.F_T]),
+                    Y.copy(),
+                    G0.copy(),
+                    f0.copy() if begun else None,
+                )
+                steps_before = int(ints[_compiled.I_STEPS])
             status = _compiled.advance(
                 prog.parts, prog.method, fs, ints, Y, G0, f0, aux,
                 out_arr, outs is not None, *bufs,
             )  # fmt: skip
             n_out = int(ints[_compiled.I_WRITTEN])
+            if self.events and int(ints[_compiled.I_STEPS]) > steps_before:
+                block = self._block(n_out, bufs, prog) if n_out else None
+                if self._step_events(rec, prog, start, fs, ints, Y, G0, block):
+                    bar.update(self.t)
+                    return
             if n_out:
                 rec.add_block(self._block(n_out, bufs, prog))
             self.t = float(fs[_compiled.F_T])
@@ -835,6 +895,138 @@ class _Loop:
                 cap = 2 * int(ints[_compiled.I_NEED]) + cap
                 bufs = self._buffers(cap, n, p.layout.n_rigid, prog.n_aux)
             self._after_chunk()
+
+    def _step_events(
+        self,
+        rec: _Recorder,
+        prog: _program.Program,
+        start: tuple[float, FloatArray, FloatArray, FloatArray | None],
+        fs: FloatArray,
+        ints: np.ndarray,
+        Y: FloatArray,
+        G0: FloatArray,
+        block: dict[str, Any] | None,
+    ) -> bool:
+        """The events of the step just accepted, from ``start`` (t, Y, G0, f0) to the loop's
+        (fs[F_T], Y, G0): each whose value changed sign (in its direction) is located and
+        recorded; the first terminal one ends the run there (its state the last output, the
+        step's later outputs dropped). Returns whether a terminal event ended the run; the
+        step's outputs are the caller's to add otherwise."""
+        p = self.p
+        t1 = float(fs[_compiled.F_T])
+        end = p.state(t1, Y, G0)
+        values = [event_value(e, t1, end) for e in self.events]
+        crossed = []
+        for e, g0, g1 in zip(self.events, self.g_prev, values, strict=True):
+            rising, falling = g0 < 0.0 <= g1, g0 > 0.0 >= g1
+            if (rising and e.direction >= 0) or (falling and e.direction <= 0):
+                crossed.append((e, 1 if rising else -1))
+        self.g_prev = values
+        if not crossed:
+            return False
+        at = self._continuous(prog, start, t1, fs, ints)
+        found = []
+        for e, way in crossed:
+            t_e = self._locate(e, at, start[0], t1)
+            found.append(EventRecord(e.name, t_e, way, e.terminal, at(t_e)))
+        found.sort(key=lambda r: (r.t, r.terminal))
+        term = next((r for r in found if r.terminal), None)
+        if term is None:
+            rec.events.extend(found)
+            return False
+        rec.events.extend(r for r in found if r.t <= term.t and not r.terminal)
+        rec.events.append(term)
+        kept = 0
+        if block is not None:
+            keep = block["t"] < term.t
+            kept = int(keep.sum())
+            if kept:
+                rec.add_block({name: col[keep] for name, col in block.items()})
+        rec.add(term.state)
+        # where the run ended, for its (complete) checkpoint
+        out_i = (
+            0
+            if self.run_args.outs is None
+            else int(ints[_compiled.I_OUT])
+            - (int(block["t"].size) - kept if block is not None else 0)
+        )
+        Y_e = p.pack(term.state)
+        self.at = (Y_e, term.state.g.copy(), float(fs[_compiled.F_H]), out_i)
+        self.t = term.t
+        self.n_rhs = int(ints[_compiled.I_RHS])
+        self.n_steps = int(ints[_compiled.I_STEPS])
+        self.n_rejected = int(ints[_compiled.I_REJECTED])
+        self.terminal = term
+        return True
+
+    def _continuous(
+        self,
+        prog: _program.Program,
+        start: tuple[float, FloatArray, FloatArray, FloatArray | None],
+        t1: float,
+        fs: FloatArray,
+        ints: np.ndarray,
+    ) -> Any:
+        """The state at any time of the step [start t, t1] as a function of t: DOP853's
+        continuous extension, or a step of the method from the step's start for methods
+        without one. The step is taken again by the loop's own helpers (_event_step)."""
+        from gmuk.engine.integrators import _event_step
+
+        t0, Y0, G0, f0 = start
+        p, m = self.p, prog.method
+        n = Y0.size
+        fs_x, ints_x = fs.copy(), ints.copy()  # scratch: the run's counters stay the loop's
+        ints_x[_compiled.I_RHS] = 0
+
+        def check(status: int) -> None:
+            self.n_event_rhs += int(ints_x[_compiled.I_RHS])
+            ints_x[_compiled.I_RHS] = 0
+            if status != _compiled.DONE:
+                raise self._failure(status, prog, fs_x, ints_x)
+
+        if f0 is None:  # the first step of a run: f at its start, as the loop's start has it
+            f0 = np.empty(n)
+            ints_x[_compiled.I_RHS] += 1
+            check(_compiled.rhs(t0, Y0, G0, prog.parts, f0, np.empty(prog.n_aux), ints_x))
+        K = np.empty((max(m.n_rows, m.n_stages + 1), n))
+        Y1 = np.empty(n)
+        h = t1 - t0
+        if m.dense:
+            F = np.empty((_compiled._tab.INTERPOLATOR_POWER, n))
+            check(_event_step.dense_step(prog.parts, m, fs_x, ints_x, t0, h, Y0, G0, f0, K, Y1, F))
+
+            def at(t: float) -> State:
+                u = np.empty(n)
+                _event_step.interpolate(F, Y0, (t - t0) / h, u)
+                return p.state(t, u, G0)
+
+            return at
+
+        def at_stepped(t: float) -> State:
+            if t == t0:
+                return p.state(t, Y0, G0)
+            Yt = np.empty(n)
+            check(
+                _event_step.method_step(prog.parts, m, fs_x, ints_x, t0, t - t0, Y0, G0, f0, K, Yt)
+            )
+            return p.state(t, Yt, G0)
+
+        return at_stepped
+
+    @staticmethod
+    def _locate(event: Event, at: Any, t0: float, t1: float) -> float:
+        """The time in [t0, t1] where ``event`` crosses zero along ``at`` (Brent, XTOL)."""
+        from scipy.optimize import brentq
+
+        def g(t: float) -> float:
+            return event_value(event, t, at(t))
+
+        ga, gb = g(t0), g(t1)
+        if gb == 0.0 or ((ga > 0.0) == (gb > 0.0) and ga != 0.0):
+            return t1  # the crossing is at the step's end, within the interpolant's round-off
+        if ga == 0.0:
+            return t0
+        return float(brentq(g, t0, t1, xtol=XTOL))
 
     def _failure(
         self, status: int, prog: _program.Program, fs: FloatArray, ints: np.ndarray

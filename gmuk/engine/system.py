@@ -37,6 +37,7 @@ from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
 from gmuk.control.base import Controller
 from gmuk.engine import _uk_kernels, solvers, uk
+from gmuk.engine.events import Event
 from gmuk.engine.integrate import simulate as _simulate
 from gmuk.engine.integrators import _program
 from gmuk.engine.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
@@ -900,6 +901,7 @@ class System:
         on_failure: Literal["raise", "return"] = "raise",
         compiled: bool | None = None,
         drift_tol: float | None = 1e-6,
+        events: Event | Sequence[Event] | None = None,
     ) -> Trajectory:
         """Integrate from ``state0`` over ``t_span`` on SE(3)ⁿ × Rᵏ.
 
@@ -946,6 +948,10 @@ class System:
             How far (in each residual's units; default 1e-6) a constraint may drift from where
             it started before the run ends with ``status="drifted"``; None records the
             violations without judging them.
+        events : Event or sequence of Event, optional
+            Functions of (t, state) whose sign changes are located to 1e-13 s
+            (:class:`gmuk.Event`, docs/events.rst): recorded in ``traj.events``, or
+            terminal (the run ends there, ``status="terminated"``).
 
         Returns
         -------
@@ -966,6 +972,7 @@ class System:
             self, state0, t_span, t_eval=t_eval, method=method, rtol=rtol, atol=atol,
             step=step, first_step=first_step, max_step=max_step, max_steps=max_steps,
             progress=progress, on_failure=on_failure, compiled=compiled, drift_tol=drift_tol,
+            events=events,
         )  # fmt: skip
 
     def __repr__(self) -> str:
