@@ -256,6 +256,48 @@ def _uniform_gravity(rng: np.random.Generator) -> Case:
     return _case(rng, gmuk.UniformGravity(rng.normal(size=3) * 10.0), _bodies(rng), (0, 100), 10)
 
 
+def _epoch(rng: np.random.Generator) -> Any:
+    from gmuk.environment import Epoch
+
+    return Epoch.from_tdb_seconds(rng.uniform(-1.5e9, 1.5e9))  # 1952-2047
+
+
+def _third_body(rng: np.random.Generator) -> Case:
+    from gmuk.environment import ThirdBodyPerturbation
+
+    perturber, centre = (("sun", "earth"), ("moon", "earth"), ("earth", "moon"))[rng.integers(3)]
+    model = ThirdBodyPerturbation(perturber, _epoch(rng), centre=centre)
+    return _case(rng, model, _bodies(rng), (1.8e6, 4.3e7), 3e3)
+
+
+def _cannonball_srp(rng: np.random.Generator) -> Case:
+    from gmuk.environment import CannonballSRP
+
+    model = CannonballSRP(_epoch(rng), rng.uniform(0.1, 50.0), rng.uniform(1.0, 2.0))
+    return _case(rng, model, _bodies(rng), (6.6e6, 4.3e7), 3e3)
+
+
+def _flat_plate_srp(rng: np.random.Generator) -> Case:
+    from gmuk.environment import FlatPlateSRP, Plate
+
+    plates = []
+    for _ in range(int(rng.integers(1, 7))):
+        c = rng.dirichlet([1.0, 1.0, 1.0])
+        plates.append(
+            Plate(rng.uniform(0.1, 20.0), _direction(rng), c[0], c[1], 1.0 - c[0] - c[1],
+                  rng.normal(size=3))
+        )  # fmt: skip
+    model = FlatPlateSRP(_epoch(rng), plates)
+    return _case(rng, model, _bodies(rng), (6.6e6, 4.3e7), 3e3)
+
+
+def _atmospheric_drag(rng: np.random.Generator) -> Case:
+    from gmuk.environment import EARTH_RADIUS, AtmosphericDrag
+
+    model = AtmosphericDrag(rng.uniform(1.5, 2.5), rng.uniform(0.1, 20.0))
+    return _case(rng, model, _bodies(rng), (EARTH_RADIUS + 1e5, EARTH_RADIUS + 1.5e6), 7e3)
+
+
 def _linear_spring_damper(rng: np.random.Generator) -> Case:
     model = gmuk.LinearSpringDamper(
         rng.uniform(0.0, 1e3), rng.uniform(0.0, 1e2), anchor=rng.normal(size=3) * 10.0
@@ -437,6 +479,18 @@ def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
         gmuk.ConfigurationTrackingT2: _configuration_tracking_t2,
         gmuk.VirtualPairT2: _virtual_pair_t2,
         gmuk.RelativeConstraint: _relative_constraint,
+        **_environment_factories(),
+    }
+
+
+def _environment_factories() -> dict[type, Callable[[np.random.Generator], Case]]:
+    from gmuk import environment as env
+
+    return {
+        env.ThirdBodyPerturbation: _third_body,
+        env.CannonballSRP: _cannonball_srp,
+        env.FlatPlateSRP: _flat_plate_srp,
+        env.AtmosphericDrag: _atmospheric_drag,
     }
 
 

@@ -17,6 +17,20 @@ ICRF-aligned axes (GCRS axes about the Earth), centred on the central body at N'
 * :class:`EclipseEvent`: umbra or penumbra entry and exit, for :func:`gmuk.simulate`.
 """
 
+from gmuk.environment.drag import (
+    VALLADO_2013,
+    AtmosphericDrag,
+    ExponentialAtmosphere,
+    exponential_density,
+)
+from gmuk.environment.earth import (
+    EARTH_MU,
+    EARTH_RADIUS,
+    EARTH_ROTATION_RATE,
+    earth_gravity,
+    earth_rotation,
+    earth_rotation_angle,
+)
 from gmuk.environment.ephemeris import (
     AU,
     BODIES,
@@ -28,20 +42,38 @@ from gmuk.environment.ephemeris import (
     position,
 )
 from gmuk.environment.shadow import shadow_fraction, shadow_margin
+from gmuk.environment.srp import SOLAR_PRESSURE_1AU, CannonballSRP, FlatPlateSRP, Plate
+from gmuk.environment.third_body import ThirdBodyPerturbation, tidal_acceleration
 from gmuk.environment.time import J2000, SCALES, Epoch
 
 __all__ = [
     "AU",
     "BODIES",
+    "EARTH_MU",
+    "EARTH_RADIUS",
+    "EARTH_ROTATION_RATE",
     "J2000",
     "MOON_ACCURACY",
     "MU",
     "RADIUS",
     "SCALES",
+    "SOLAR_PRESSURE_1AU",
     "SUN_ACCURACY",
+    "VALLADO_2013",
+    "AtmosphericDrag",
+    "CannonballSRP",
     "Ephemeris",
     "Epoch",
+    "ExponentialAtmosphere",
+    "FlatPlateSRP",
+    "Plate",
+    "ThirdBodyPerturbation",
+    "earth_gravity",
+    "earth_rotation",
+    "earth_rotation_angle",
+    "exponential_density",
     "position",
     "shadow_fraction",
     "shadow_margin",
+    "tidal_acceleration",
 ]
