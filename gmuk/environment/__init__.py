@@ -31,6 +31,7 @@ from gmuk.environment.earth import (
     earth_rotation,
     earth_rotation_angle,
 )
+from gmuk.environment.eclipse import EclipseEvent
 from gmuk.environment.ephemeris import (
     AU,
     BODIES,
@@ -62,6 +63,7 @@ __all__ = [
     "VALLADO_2013",
     "AtmosphericDrag",
     "CannonballSRP",
+    "EclipseEvent",
     "Ephemeris",
     "Epoch",
     "ExponentialAtmosphere",
