@@ -17,12 +17,7 @@ ICRF-aligned axes (GCRS axes about the Earth), centred on the central body at N'
 * :class:`EclipseEvent`: umbra or penumbra entry and exit, for :func:`gmuk.simulate`.
 """
 
-from gmuk.environment.drag import (
-    VALLADO_2013,
-    AtmosphericDrag,
-    ExponentialAtmosphere,
-    exponential_density,
-)
+from gmuk.environment.drag import VALLADO_2013, AtmosphericDrag, ExponentialAtmosphere
 from gmuk.environment.earth import (
     EARTH_MU,
     EARTH_RADIUS,
@@ -73,7 +68,6 @@ __all__ = [
     "earth_gravity",
     "earth_rotation",
     "earth_rotation_angle",
-    "exponential_density",
     "position",
     "shadow_fraction",
     "shadow_margin",
