@@ -451,11 +451,63 @@ def _relative_constraint(rng: np.random.Generator) -> Case:
     return _case(rng, c, (lead, body), (0.0, 100.0), 10.0)
 
 
+def _joint(cls: type) -> Callable[[np.random.Generator], Case]:
+    """A joint of kind ``cls`` between two random bodies, or to the ground, at random joint
+    frames and random (not necessarily consistent) states."""
+
+    def make(rng: np.random.Generator) -> Case:
+        from gmuk import robots
+
+        parent = gmuk.RigidBody("parent", rng.uniform(1.0, 10.0), _inertia(rng))
+        child = _bodies(rng)[0]
+        grounded = bool(rng.integers(0, 2))
+        kw: dict[str, Any] = {
+            "parent_frame": _pose(rng, rng.normal(size=3)),
+            "child_frame": _pose(rng, 0.3 * rng.normal(size=3)),
+            "baumgarte": _baumgarte(rng),
+        }
+        if cls in (robots.RevoluteJoint, robots.PrismaticJoint, robots.CylindricalJoint):
+            kw["axis"] = _direction(rng)
+        elif cls is robots.ScrewJoint:
+            kw.update(axis=_direction(rng), pitch=rng.uniform(-0.1, 0.1) or 0.05)
+        elif cls is robots.PlanarJoint:
+            kw["normal"] = _direction(rng)
+        elif cls is robots.UniversalJoint:
+            a1 = _direction(rng)
+            a2 = np.cross(a1, _direction(rng))
+            kw.update(axis1=a1, axis2=a2 / np.linalg.norm(a2))
+        joint = cls(None if grounded else parent, child, **kw)
+        bodies = (child,) if grounded else (parent, child)
+        return _case(rng, joint, bodies, (0.0, 10.0), 1.0)
+
+    return make
+
+
+def _joint_force(cls: type) -> Callable[[np.random.Generator], Case]:
+    """A generalised force of kind ``cls`` on a random revolute or prismatic joint."""
+
+    def make(rng: np.random.Generator) -> Case:
+        from gmuk import robots
+
+        parent = gmuk.RigidBody("parent", rng.uniform(1.0, 10.0), _inertia(rng))
+        child = _bodies(rng)[0]
+        kind = robots.RevoluteJoint if rng.integers(0, 2) else robots.PrismaticJoint
+        joint = kind(parent, child, axis=_direction(rng), parent_frame=_pose(rng, np.ones(3)))
+        if cls is robots.JointEffort:
+            force = cls(joint, rng.normal(size=1))
+        else:
+            force = cls(joint, stiffness=rng.uniform(0, 10), damping=rng.uniform(0, 1))
+        return _case(rng, force, (parent, child), (0.0, 10.0), 1.0)
+
+    return make
+
+
 def _baumgarte(rng: np.random.Generator) -> gmuk.Baumgarte | None:
     return None if rng.integers(0, 2) else gmuk.Baumgarte.critical(rng.uniform(0.01, 1.0))
 
 
 def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
+    from gmuk import robots
     from gmuk.forces.thesis_gravity import ThesisRadialHarmonicGravity
     from gmuk.optimize.result import OpenLoopControl
     from gmuk.scenarios.unmodeled import HarmonicPerturbation
@@ -480,7 +532,25 @@ def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
         gmuk.VirtualPairT2: _virtual_pair_t2,
         gmuk.RelativeConstraint: _relative_constraint,
         **_environment_factories(),
+        **{cls: _joint(cls) for cls in _joint_kinds()},
+        robots.JointEffort: _joint_force(robots.JointEffort),
+        robots.JointSpringDamper: _joint_force(robots.JointSpringDamper),
     }
+
+
+def _joint_kinds() -> list[type]:
+    from gmuk import robots
+
+    return [
+        robots.FixedJoint,
+        robots.RevoluteJoint,
+        robots.PrismaticJoint,
+        robots.CylindricalJoint,
+        robots.ScrewJoint,
+        robots.SphericalJoint,
+        robots.PlanarJoint,
+        robots.UniversalJoint,
+    ]
 
 
 def _environment_factories() -> dict[type, Callable[[np.random.Generator], Case]]:

@@ -1,0 +1,721 @@
+"""Joints: constraint kinds that tie a child body to a parent body (or to the ground).
+
+A joint has two frames: ``J_p``, fixed in the parent at ``X_PJ`` (its pose in the parent's
+body frame; in the inertial frame N for a joint to the ground), and ``J_c``, fixed in the
+child at ``X_CJ``. At the joint's zero the two frames coincide; the joint lets the relative
+pose ``h = g_{J_p}⁻¹ g_{J_c}`` move along its *motion subspace* S (6 × k, [ω; v] components in
+J_c) and nowhere else. With the joint frames' twists ``V_{J_p} = Ad_{X_PJ⁻¹} V_P`` and
+``V_{J_c} = Ad_{X_CJ⁻¹} V_C`` the relative twist is (McCann 2020, Eq. 73 and Section 4.1.3)
+
+``V_rel = V_{J_c} − Ad_{h⁻¹} V_{J_p}``,
+
+and a joint with a constant S holds ``T V̇_rel = 0`` for the rows T (6 − k, orthonormal) that
+annihilate S: the rows of a :class:`~gmuk.RelativeConstraint` between the joint frames
+(:func:`gmuk.constraints.relative.relative_rows`), mapped back to the bodies' twists by the
+constant ``Ad_{X⁻¹}``. Baumgarte terms stabilise the rows with the velocity residual
+``T V_rel`` and the position residual ``T log(h)``, which is zero exactly when the joint holds
+(:func:`joint_residuals`). The universal joint, whose constrained rotation direction moves
+with it, and the screw joint, whose log is not single-valued past half a turn, have their
+own residuals (see their classes).
+
+The joints' numbers are written once, in :func:`joint_rows` and :func:`joint_residuals`;
+the Python ``rows`` and the compiled loop call the same kernel.
+"""
+
+from __future__ import annotations
+
+import abc
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+from gmuk._forms import Forms
+from gmuk._numba import njit
+from gmuk._validation import FloatArray, as_array, check_se3, real_number
+from gmuk.bodies import BodyKind
+from gmuk.constraints.base import Baumgarte, Constraint
+from gmuk.constraints.relative import relative_rows
+from gmuk.errors import DefinitionError
+from gmuk.lie import se3
+from gmuk.lie._kernels import _se3_exp, _se3_log_into
+
+if TYPE_CHECKING:
+    from gmuk.bodies import Body
+    from gmuk.state import State
+    from gmuk.trajectory import Trajectory
+
+__all__ = [
+    "CylindricalJoint",
+    "FixedJoint",
+    "Joint",
+    "PlanarJoint",
+    "PrismaticJoint",
+    "RevoluteJoint",
+    "ScrewJoint",
+    "SphericalJoint",
+    "UniversalJoint",
+    "joint_residuals",
+    "joint_rows",
+    "unwrap_with_rates",
+]
+
+# kinds of residual (the parameters' second entry)
+_CONSTANT, _UNIVERSAL, _SCREW = 0, 1, 2
+# layout of the packed parameters: [grounded, kind, s, X_PJ (16), X_CJ (16),
+# Ad_{X_PJ⁻¹} (36), Ad_{X_CJ⁻¹} (36), T (s × 6), α (s), β (s), extra (6)]
+_HEAD = 3 + 16 + 16 + 36 + 36
+
+
+@njit(cache=True)
+def _unpack(g1, V1, g2, V2, p):  # type: ignore[no-untyped-def]
+    """The joint frames' poses and twists (g_Jp, V_Jp, g_Jc, V_Jc) from the bodies'."""
+    XP = p[3:19].reshape(4, 4)
+    XC = p[19:35].reshape(4, 4)
+    AdP = p[35:71].reshape(6, 6)
+    AdC = p[71:107].reshape(6, 6)
+    if p[0] != 0.0:  # to the ground: J_p is fixed in N
+        gJp = XP.copy()
+        VJp = np.zeros(6)
+        gJc = g1 @ XC
+        VJc = AdC @ V1
+    else:
+        gJp = g1 @ XP
+        VJp = AdP @ V1
+        gJc = g2 @ XC
+        VJc = AdC @ V2
+    return gJp, VJp, gJc, VJc, AdP, AdC
+
+
+@njit(cache=True)
+def _relative_pose(gJp, gJc):  # type: ignore[no-untyped-def]
+    """h = g_Jp⁻¹ g_Jc."""
+    h = np.zeros((4, 4))
+    for i in range(3):
+        for j in range(3):
+            h[i, j] = gJp[0, i] * gJc[0, j] + gJp[1, i] * gJc[1, j] + gJp[2, i] * gJc[2, j]
+        h[i, 3] = (
+            gJp[0, i] * (gJc[0, 3] - gJp[0, 3])
+            + gJp[1, i] * (gJc[1, 3] - gJp[1, 3])
+            + gJp[2, i] * (gJc[2, 3] - gJp[2, 3])
+        )
+    h[3, 3] = 1.0
+    return h
+
+
+@njit(cache=True)
+def _rows_matrix(p, h):  # type: ignore[no-untyped-def]
+    """The constraint rows T (s, 6) at relative pose h, and for a universal joint the
+    direction n = a₁ × a₂ (a₁ = R_hᵀ a₁ᵖ, in J_c) of its rotation row."""
+    s = int(p[2])
+    T = p[_HEAD : _HEAD + 6 * s].reshape(s, 6).copy()
+    n = np.zeros(3)
+    a1 = np.zeros(3)
+    if p[1] == _UNIVERSAL:
+        e = _HEAD + 8 * s
+        for i in range(3):
+            a1[i] = h[0, i] * p[e] + h[1, i] * p[e + 1] + h[2, i] * p[e + 2]
+        a2 = p[e + 3 : e + 6]
+        n[0] = a1[1] * a2[2] - a1[2] * a2[1]
+        n[1] = a1[2] * a2[0] - a1[0] * a2[2]
+        n[2] = a1[0] * a2[1] - a1[1] * a2[0]
+        for k in range(3):
+            T[s - 1, k] = n[k]
+            T[s - 1, 3 + k] = 0.0
+    return T, n, a1
+
+
+@njit(cache=True)
+def _position_residual(p, h, T, a1):  # type: ignore[no-untyped-def]
+    """Φ (s,): zero exactly when the joint holds, with Φ̇ = T V_rel to first order."""
+    s = int(p[2])
+    xi = np.empty((1, 6))
+    hh = np.empty((1, 4, 4))
+    hh[0] = h
+    if p[1] == _SCREW:  # unscrew by the turn its slide implies: h exp(−θ_d S)
+        e = _HEAD + 8 * s
+        axis = p[e : e + 3]
+        pitch = p[e + 3]
+        slide = axis[0] * h[0, 3] + axis[1] * h[1, 3] + axis[2] * h[2, 3]
+        theta = slide / pitch
+        back = np.empty(6)
+        for k in range(3):
+            back[k] = -theta * axis[k]
+            back[3 + k] = -theta * pitch * axis[k]
+        u = np.empty((4, 4))
+        _se3_exp(back, u)
+        hh[0] = h @ u
+    _se3_log_into(hh, xi)
+    phi = T @ xi[0]
+    if p[1] == _UNIVERSAL:  # −a₁·a₂, whose rate is n·ω_rel
+        e = _HEAD + 8 * s
+        phi[s - 1] = -(a1[0] * p[e + 3] + a1[1] * p[e + 4] + a1[2] * p[e + 5])
+    return phi
+
+
+@njit(cache=True)
+def joint_residuals(g1, V1, g2, V2, p, pos, vel):  # type: ignore[no-untyped-def]
+    """A joint's position residual Φ (s,) and velocity residual T V_rel (s,), written into
+    ``pos`` and ``vel`` (module docstring; p packed by :meth:`Joint._kernel_params`)."""
+    gJp, VJp, gJc, VJc, _, _ = _unpack(g1, V1, g2, V2, p)
+    h = _relative_pose(gJp, gJc)
+    T, _, a1 = _rows_matrix(p, h)
+    Ad_h_inv = se3_Ad_inverse(h)
+    Vr = VJc - Ad_h_inv @ VJp
+    pos[:] = _position_residual(p, h, T, a1)
+    vel[:] = T @ Vr
+
+
+@njit(cache=True)
+def se3_Ad_inverse(h):  # type: ignore[no-untyped-def]
+    """Ad_{h⁻¹} = [[Rᵀ, 0], [−Rᵀ p^, Rᵀ]] (6, 6) for h = (R, p)."""
+    out = np.zeros((6, 6))
+    p0, p1, p2 = h[0, 3], h[1, 3], h[2, 3]
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = h[j, i]
+            out[3 + i, 3 + j] = h[j, i]
+    P = np.array([[0.0, -p2, p1], [p2, 0.0, -p0], [-p1, p0, 0.0]])
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for k in range(3):
+                acc += h[k, i] * P[k, j]
+            out[3 + i, j] = -acc
+    return out
+
+
+@njit(cache=True)
+def joint_rows(t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
+    """The rows of a joint into A (s, 12) and b (s,): columns [V_P, V_C] (a joint to the
+    ground: [V_C, 0]); ``T V̇_rel = −α T V_rel − β Φ`` (module docstring). Returns 0."""
+    s = int(p[2])
+    gJp, VJp, gJc, VJc, AdP, AdC = _unpack(g1, V1, g2, V2, p)
+    h = _relative_pose(gJp, gJc)
+    T, _n, a1 = _rows_matrix(p, h)
+    At = np.empty((s, 12))
+    bt = np.empty(s)
+    Vr = np.empty(6)
+    relative_rows(gJp, VJp, gJc, VJc, T, np.zeros(6), At, bt, Vr)
+    child = np.ascontiguousarray(At[:, 6:]) @ AdC
+    if p[0] != 0.0:
+        A[:, :6] = child
+        A[:, 6:] = 0.0
+    else:
+        A[:, :6] = np.ascontiguousarray(At[:, :6]) @ AdP
+        A[:, 6:] = child
+    if p[1] == _UNIVERSAL:  # d/dt (n·ω_rel) = n·ω̇_rel + ṅ·ω_rel, ṅ = (−ω_rel × a₁) × a₂
+        e = _HEAD + 8 * s
+        w0, w1, w2 = Vr[0], Vr[1], Vr[2]
+        d0 = -(w1 * a1[2] - w2 * a1[1])
+        d1 = -(w2 * a1[0] - w0 * a1[2])
+        d2 = -(w0 * a1[1] - w1 * a1[0])
+        q0, q1, q2 = p[e + 3], p[e + 4], p[e + 5]
+        nd0 = d1 * q2 - d2 * q1
+        nd1 = d2 * q0 - d0 * q2
+        nd2 = d0 * q1 - d1 * q0
+        bt[s - 1] -= nd0 * w0 + nd1 * w1 + nd2 * w2
+    alpha = p[_HEAD + 6 * s : _HEAD + 7 * s]
+    beta = p[_HEAD + 7 * s : _HEAD + 8 * s]
+    stabilised = False
+    for i in range(s):
+        if alpha[i] != 0.0 or beta[i] != 0.0:
+            stabilised = True
+    if stabilised:
+        phi = _position_residual(p, h, T, a1)
+        vel = T @ Vr
+        for i in range(s):
+            bt[i] -= alpha[i] * vel[i] + beta[i] * phi[i]
+    b[:] = bt
+    return 0
+
+
+def unwrap_with_rates(q: FloatArray, qd: FloatArray, t: FloatArray) -> FloatArray:
+    """Angles (N, k) in (−π, π] made continuous: output i takes the branch ``q_i + 2π n``
+    nearest ``q_{i−1} + ½ (q̇_{i−1} + q̇_i)(t_i − t_{i−1})`` (the trapezoid rule on the rates,
+    rad/s, at times t (N,), s). Unlike ``np.unwrap`` it follows a joint that turns more than
+    π between outputs, as long as the trapezoid rule is within π of the true turn."""
+    out = np.array(q, dtype=float, copy=True)
+    for i in range(1, len(out)):
+        predicted = out[i - 1] + 0.5 * (qd[i - 1] + qd[i]) * (t[i] - t[i - 1])
+        out[i] = q[i] + 2.0 * np.pi * np.round((predicted - q[i]) / (2.0 * np.pi))
+    return out
+
+
+def _unit(axis: Any, name: str) -> FloatArray:
+    a = as_array(axis, (3,), name, batch=False)
+    norm = float(np.linalg.norm(a))
+    if not norm > 0.0:
+        raise DefinitionError(f"{name} must be a nonzero 3-vector; got {a.tolist()}")
+    return a / norm
+
+
+def _perpendiculars(a: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Two unit vectors (e₁, e₂) with (e₁, e₂, a) right-handed and orthonormal: e₁ is the
+    coordinate axis least aligned with ``a``, made perpendicular to it (a = z gives x, y)."""
+    helper = np.eye(3)[int(np.argmin(np.abs(a)))]
+    e1 = helper - (helper @ a) * a
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(a, e1)
+
+
+def _annihilator(S: FloatArray) -> FloatArray:
+    """Orthonormal rows T (6 − k, 6) with T S = 0, for S (6, k) of rank k."""
+    if S.shape[1] == 0:
+        return np.eye(6)
+    u, _, _ = np.linalg.svd(S, full_matrices=True)
+    T = u[:, S.shape[1] :].T
+    T[np.abs(T) < 1e-15] = 0.0
+    return np.ascontiguousarray(T)
+
+
+#: The forms of every joint kind: the compiled kernel :func:`joint_rows`.
+_JOINT_FORMS = Forms(
+    compiled=True,
+    symbolic="gmuk.optimize transcribes no joint (its rows are acceleration-level)",
+)
+
+
+class Joint(Constraint):
+    """A joint between a parent body (or the ground) and a child body.
+
+    Subclasses give the motion subspace; see the module docstring for the frames and the
+    rows. Columns of A: [V_P, V_C] (6 + 6), or [V_C] for a joint to the ground.
+
+    Parameters
+    ----------
+    parent : Body, str or None
+        The parent rigid body, or None for the ground (the inertial frame N).
+    child : Body or str
+        The child rigid body.
+    parent_frame : array_like (4, 4), optional
+        X_PJ: the pose of the joint frame J_p in the parent's body frame (in N for the
+        ground); identity by default (m).
+    child_frame : array_like (4, 4), optional
+        X_CJ: the pose of the joint frame J_c in the child's body frame; identity by default.
+    baumgarte : Baumgarte, optional
+        Gains α (1/s) and β (1/s²) on the velocity and position residuals.
+    name : str, optional
+
+    Attributes
+    ----------
+    nq, nv : int
+        Number of joint coordinates and rates (:meth:`coordinates`, :meth:`rates`).
+    motion_subspace : ndarray (6, nv)
+        S: the relative twist [ω; v] (in J_c) that a unit rate of each coordinate gives.
+    """
+
+    body_kinds = frozenset({BodyKind.RIGID})
+    _forms = _JOINT_FORMS
+    _kernel = staticmethod(joint_rows)
+    _residual_kind: ClassVar[int] = _CONSTANT
+    kind: ClassVar[str] = "joint"
+
+    def __init__(
+        self,
+        parent: Body | str | None,
+        child: Body | str,
+        *,
+        parent_frame: Any = None,
+        child_frame: Any = None,
+        baumgarte: Baumgarte | None = None,
+        name: str | None = None,
+    ) -> None:
+        bodies = [child] if parent is None else [parent, child]
+        super().__init__(bodies, name=name)
+        (baumgarte,) = self._keywords(baumgarte=baumgarte)
+        who = f"{type(self).__name__} {self.name!r}"
+        X_PJ = np.eye(4) if parent_frame is None else check_se3(parent_frame, f"{who} parent_frame")
+        X_CJ = np.eye(4) if child_frame is None else check_se3(child_frame, f"{who} child_frame")
+        self.grounded = parent is None
+        self.parent_frame = np.array(X_PJ, dtype=float)
+        self.child_frame = np.array(X_CJ, dtype=float)
+        self.baumgarte = baumgarte
+        S = self._subspace()
+        self.motion_subspace = S
+        self.nv = S.shape[1]
+        self.nq = self.nv
+        self._T = self._constraint_rows(S)
+        s = self._T.shape[0]
+        self._alpha = self._gain(baumgarte.alpha if baumgarte else 0.0, s, "alpha")
+        self._beta = self._gain(baumgarte.beta if baumgarte else 0.0, s, "beta")
+        self._params = np.concatenate(
+            [
+                [float(self.grounded), float(self._residual_kind), float(s)],
+                self.parent_frame.ravel(),
+                self.child_frame.ravel(),
+                se3._Ad(se3._inverse(self.parent_frame)).ravel(),
+                se3._Ad(se3._inverse(self.child_frame)).ravel(),
+                self._T.ravel(),
+                self._alpha,
+                self._beta,
+                self._extra(),
+            ]
+        )
+        self._S_pinv = np.linalg.pinv(S) if S.shape[1] else np.zeros((0, 6))
+
+    # -- what a kind defines
+    @abc.abstractmethod
+    def _subspace(self) -> FloatArray:
+        """S (6, k)."""
+
+    def _constraint_rows(self, S: FloatArray) -> FloatArray:
+        """T (s, 6), the constant rows (the universal joint's last row is set at each call)."""
+        return _annihilator(S)
+
+    def _extra(self) -> FloatArray:
+        """Six numbers a kind's residual needs (axes, pitch)."""
+        return np.zeros(6)
+
+    def _gain(self, value: Any, s: int, label: str) -> FloatArray:
+        try:
+            return np.array(np.broadcast_to(np.asarray(value, dtype=float), (s,)))
+        except ValueError:
+            raise DefinitionError(
+                f"the Baumgarte gain {label} of {type(self).__name__} {self.name!r} must be a "
+                f"scalar or one per row ({s}); got shape {np.shape(value)}"
+            ) from None
+
+    # -- the constraint
+    def _kernel_params(self) -> tuple[FloatArray, int]:
+        return self._params, self._T.shape[0]
+
+    def _pair(self, state: State) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        idx = self._rigid_indices(state)
+        if self.grounded:
+            (i,) = idx
+            return state.g[i], state.V[i], state.g[i], state.V[i]
+        i, j = idx
+        return state.g[i], state.V[i], state.g[j], state.V[j]
+
+    def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
+        """(A, b): columns [V_P, V_C], or [V_C] for a joint to the ground."""
+        s = self._T.shape[0]
+        A, b = np.empty((s, 12)), np.empty(s)
+        joint_rows(state.t, *self._pair(state), self._params, A, b)
+        return (A[:, :6] if self.grounded else A), b
+
+    def violation(self, state: State) -> tuple[FloatArray, FloatArray]:
+        """(Φ, T V_rel): position residual (rad, m) and velocity residual (rad/s, m/s)."""
+        s = self._T.shape[0]
+        pos, vel = np.empty(s), np.empty(s)
+        joint_residuals(*self._pair(state), self._params, pos, vel)
+        return pos, vel
+
+    # -- reading the joint
+    def relative_pose(self, state: State) -> FloatArray:
+        """h = g_{J_p}⁻¹ g_{J_c} (4, 4): J_c in J_p (m)."""
+        gP, _, gC, _ = self._pair(state)
+        gJp = self.parent_frame if self.grounded else gP @ self.parent_frame
+        return se3._inverse(gJp) @ (gC @ self.child_frame)
+
+    def relative_twist(self, state: State) -> FloatArray:
+        """V_rel = V_{J_c} − Ad_{h⁻¹} V_{J_p} (6,), [ω; v] in J_c (rad/s, m/s)."""
+        _gP, VP, _gC, VC = self._pair(state)
+        VJc = se3._Ad(se3._inverse(self.child_frame)) @ VC
+        if self.grounded:
+            return VJc
+        VJp = se3._Ad(se3._inverse(self.parent_frame)) @ VP
+        return VJc - se3._Ad(se3._inverse(self.relative_pose(state))) @ VJp
+
+    def relative_acceleration(self, state: State, Vdot_P: Any, Vdot_C: Any) -> FloatArray:
+        """V̇_rel (6,), the rate of V_rel's components in J_c, from the bodies' V̇ (rad/s², m/s²).
+
+        ``V̇_rel = Ad_{X_CJ⁻¹} V̇_C − Ad_{h⁻¹} Ad_{X_PJ⁻¹} V̇_P + ad_{V_rel} Ad_{h⁻¹} V_{J_p}``.
+        """
+        _gP, VP, _gC, _VC = self._pair(state)
+        out = se3._Ad(se3._inverse(self.child_frame)) @ np.asarray(Vdot_C, dtype=float)
+        if self.grounded:
+            return out
+        Ad_h_inv = se3._Ad(se3._inverse(self.relative_pose(state)))
+        AdP = se3._Ad(se3._inverse(self.parent_frame))
+        W = Ad_h_inv @ (AdP @ VP)
+        return (
+            out
+            - Ad_h_inv @ (AdP @ np.asarray(Vdot_P, dtype=float))
+            + se3._ad(self.relative_twist(state)) @ W
+        )
+
+    def rates(self, state: State) -> FloatArray:
+        """Joint rates q̇ (nv,): ``S⁺ V_rel`` (rad/s, m/s)."""
+        return self._S_pinv @ self.relative_twist(state)
+
+    def coordinates(self, state: State) -> FloatArray:
+        """Joint coordinates (nq,) at ``state`` (rad, m); angles in (−π, π] (see
+        :meth:`coordinates_along` for a trajectory's, unwrapped)."""
+        return self._S_pinv @ se3._log(self.relative_pose(state))
+
+    def coordinates_along(self, traj: Trajectory) -> FloatArray:
+        """Joint coordinates at every output of ``traj`` (N, nq), angles unwrapped: each
+        output takes the branch nearest the angle the rates predict from the one before
+        (:func:`unwrap_with_rates`), so that a joint may turn more than π between outputs."""
+        states = [traj.state(i) for i in range(len(traj))]
+        q = np.array([self.coordinates(s) for s in states]).reshape(len(states), self.nq)
+        if not self._angular.any():
+            return q
+        qd = np.array([self.rates(s) for s in states]).reshape(len(states), self.nv)
+        out = q.copy()
+        out[:, self._angular] = unwrap_with_rates(
+            q[:, self._angular], qd[:, self._angular], np.asarray(traj.t)
+        )
+        return out
+
+    def rates_along(self, traj: Trajectory) -> FloatArray:
+        """Joint rates at every output of ``traj`` (N, nv)."""
+        rows = [self.rates(traj.state(i)) for i in range(len(traj))]
+        return np.array(rows).reshape(len(rows), self.nv)
+
+    @property
+    def _angular(self) -> np.ndarray:
+        """Which coordinates are angles that wrap (and whose rates are their derivatives)."""
+        return np.linalg.norm(self.motion_subspace[:3], axis=0) > 0.0
+
+    def wrenches(self, state: State, tau: Any) -> tuple[FloatArray, FloatArray]:
+        """The body-frame wrenches [L; f] on the parent and the child of generalised joint
+        forces ``tau`` (nv,) (N·m, N): ``W_C = Ad_{X_CJ⁻¹}ᵀ S τ``,
+        ``W_P = −(Ad_{h⁻¹} Ad_{X_PJ⁻¹})ᵀ S τ`` (zero for a joint to the ground). Their power
+        is ``τ · q̇``."""
+        F = self._subspace_at(state) @ np.asarray(tau, dtype=float)
+        W_C = se3._Ad(se3._inverse(self.child_frame)).T @ F
+        if self.grounded:
+            return np.zeros(6), W_C
+        Ad_h_inv = se3._Ad(se3._inverse(self.relative_pose(state)))
+        AdP = se3._Ad(se3._inverse(self.parent_frame))
+        return -(Ad_h_inv @ AdP).T @ F, W_C
+
+    def _subspace_at(self, state: State) -> FloatArray:
+        """S at ``state`` (constant but for the universal joint)."""
+        return self.motion_subspace
+
+    @property
+    def parent(self) -> Body | str | None:
+        """The parent body (None: the ground)."""
+        return None if self.grounded else self.bodies[0]
+
+    @property
+    def child(self) -> Body | str:
+        """The child body."""
+        return self.bodies[-1]
+
+
+def _axis_subspace(angular: Sequence[FloatArray], linear: Sequence[FloatArray]) -> FloatArray:
+    cols = [np.concatenate([a, np.zeros(3)]) for a in angular]
+    cols += [np.concatenate([np.zeros(3), a]) for a in linear]
+    return np.array(cols, dtype=float).T.reshape(6, len(cols))
+
+
+class FixedJoint(Joint):
+    """Welds the child to the parent: no relative motion (6 rows)."""
+
+    kind = "fixed"
+    _forms = _JOINT_FORMS
+
+    def _subspace(self) -> FloatArray:
+        return np.zeros((6, 0))
+
+
+class RevoluteJoint(Joint):
+    """Rotation about ``axis`` (unit, in the joint frames; default z) through their common
+    origin: 5 rows; coordinate the angle (rad).
+
+    Parameters
+    ----------
+    axis : array_like (3,), optional
+    (the others as :class:`Joint`)
+    """
+
+    kind = "revolute"
+    _forms = _JOINT_FORMS
+
+    def __init__(
+        self, parent: Body | str | None, child: Body | str, *, axis: Any = (0, 0, 1), **kw: Any
+    ) -> None:
+        self.axis = _unit(axis, "axis")
+        super().__init__(parent, child, **kw)
+
+    def _subspace(self) -> FloatArray:
+        return _axis_subspace([self.axis], [])
+
+
+class PrismaticJoint(Joint):
+    """Translation along ``axis`` (default z): 5 rows; coordinate the displacement (m)."""
+
+    kind = "prismatic"
+    _forms = _JOINT_FORMS
+
+    def __init__(
+        self, parent: Body | str | None, child: Body | str, *, axis: Any = (0, 0, 1), **kw: Any
+    ) -> None:
+        self.axis = _unit(axis, "axis")
+        super().__init__(parent, child, **kw)
+
+    def _subspace(self) -> FloatArray:
+        return _axis_subspace([], [self.axis])
+
+
+class CylindricalJoint(Joint):
+    """Rotation about and translation along ``axis``: 4 rows; coordinates (angle, slide)."""
+
+    kind = "cylindrical"
+    _forms = _JOINT_FORMS
+
+    def __init__(
+        self, parent: Body | str | None, child: Body | str, *, axis: Any = (0, 0, 1), **kw: Any
+    ) -> None:
+        self.axis = _unit(axis, "axis")
+        super().__init__(parent, child, **kw)
+
+    def _subspace(self) -> FloatArray:
+        return _axis_subspace([self.axis], [self.axis])
+
+
+class ScrewJoint(Joint):
+    """A helical joint: rotation θ about ``axis`` with the slide ``pitch · θ`` along it
+    (pitch in m/rad): 5 rows; coordinate the angle (rad).
+
+    Its position residual unscrews h by the angle its slide implies,
+    ``Φ = T log(h exp(−(a·p_h / pitch) S))``: ``T log(h)`` would not be single-valued once
+    the joint turns past half a turn.
+    """
+
+    kind = "screw"
+    _forms = _JOINT_FORMS
+    _residual_kind = _SCREW
+
+    def __init__(
+        self,
+        parent: Body | str | None,
+        child: Body | str,
+        *,
+        axis: Any = (0, 0, 1),
+        pitch: float,
+        **kw: Any,
+    ) -> None:
+        self.axis = _unit(axis, "axis")
+        self.pitch = real_number(pitch, "pitch")
+        if self.pitch == 0.0:
+            raise DefinitionError("a ScrewJoint needs a nonzero pitch; use a RevoluteJoint")
+        super().__init__(parent, child, **kw)
+
+    def _subspace(self) -> FloatArray:
+        return np.concatenate([self.axis, self.pitch * self.axis])[:, None]
+
+    def _extra(self) -> FloatArray:
+        return np.array([*self.axis, self.pitch, 0.0, 0.0])
+
+    def coordinates(self, state: State) -> FloatArray:
+        """The angle θ = slide / pitch (rad): single-valued, so it needs no unwrapping."""
+        h = self.relative_pose(state)
+        return np.array([float(self.axis @ h[:3, 3]) / self.pitch])
+
+    @property
+    def _angular(self) -> np.ndarray:
+        return np.zeros(1, dtype=bool)  # its angle is slide / pitch: single-valued
+
+
+class SphericalJoint(Joint):
+    """A ball joint: the joint frames' origins coincide (3 rows). Coordinates: the rotation
+    vector of J_c in J_p (rad, (3,)); rates: ω_rel in J_c (rad/s)."""
+
+    kind = "spherical"
+    _forms = _JOINT_FORMS
+
+    def _subspace(self) -> FloatArray:
+        return _axis_subspace(list(np.eye(3)), [])
+
+    @property
+    def _angular(self) -> np.ndarray:
+        return np.zeros(3, dtype=bool)  # a rotation vector: not unwrapped
+
+
+class PlanarJoint(Joint):
+    """Motion in the plane normal to ``normal`` (default z): rotation about the normal and
+    translation in the plane (3 rows). Coordinates: (θ, x, y) with x, y along the plane's
+    two in-plane axes ``in_plane`` (rad, m)."""
+
+    kind = "planar"
+    _forms = _JOINT_FORMS
+
+    def __init__(
+        self, parent: Body | str | None, child: Body | str, *, normal: Any = (0, 0, 1), **kw: Any
+    ) -> None:
+        self.normal = _unit(normal, "normal")
+        self.in_plane = _perpendiculars(self.normal)
+        super().__init__(parent, child, **kw)
+
+    def _subspace(self) -> FloatArray:
+        return _axis_subspace([self.normal], list(self.in_plane))
+
+    def coordinates(self, state: State) -> FloatArray:
+        """(θ, x, y): the angle about the normal and J_c's origin in J_p's plane axes."""
+        h = self.relative_pose(state)
+        theta = float(self.normal @ se3._log(h)[:3])
+        e1, e2 = self.in_plane
+        return np.array([theta, float(e1 @ h[:3, 3]), float(e2 @ h[:3, 3])])
+
+
+class UniversalJoint(Joint):
+    """A Cardan (Hooke) joint: rotation about ``axis1`` (fixed in J_p, default x) then about
+    ``axis2`` (fixed in J_c, default y), perpendicular, through a common point (4 rows).
+
+    Its rotation row is ``n · ω̇_rel = −ṅ · ω_rel`` with ``n = a₁ × a₂`` in J_c, which moves with
+    the joint; the position residual is ``−a₁ · a₂`` (zero while the axes stay perpendicular).
+    Coordinates (q₁, q₂) with ``R_h = Rot(axis1, q₁) Rot(axis2, q₂)`` (rad).
+    """
+
+    kind = "universal"
+    _forms = _JOINT_FORMS
+    _residual_kind = _UNIVERSAL
+
+    def __init__(
+        self,
+        parent: Body | str | None,
+        child: Body | str,
+        *,
+        axis1: Any = (1, 0, 0),
+        axis2: Any = (0, 1, 0),
+        **kw: Any,
+    ) -> None:
+        self.axis1 = _unit(axis1, "axis1")
+        self.axis2 = _unit(axis2, "axis2")
+        if abs(float(self.axis1 @ self.axis2)) > 1e-12:
+            raise DefinitionError(
+                f"a UniversalJoint's axes must be perpendicular; got axis1·axis2 = "
+                f"{float(self.axis1 @ self.axis2):.3g}"
+            )
+        super().__init__(parent, child, **kw)
+
+    def _subspace(self) -> FloatArray:
+        # at the joint's zero; the first column moves with the joint (see rates)
+        return _axis_subspace([self.axis1, self.axis2], [])
+
+    def _constraint_rows(self, S: FloatArray) -> FloatArray:
+        T = np.zeros((4, 6))
+        T[:3, 3:] = np.eye(3)
+        return T  # the last row, [n; 0], is set at each call
+
+    def _extra(self) -> FloatArray:
+        return np.concatenate([self.axis1, self.axis2])
+
+    def _axes_now(self, state: State) -> FloatArray:
+        R = self.relative_pose(state)[:3, :3]
+        return np.column_stack([R.T @ self.axis1, self.axis2])
+
+    def _subspace_at(self, state: State) -> FloatArray:
+        return np.vstack([self._axes_now(state), np.zeros((3, 2))])
+
+    def rates(self, state: State) -> FloatArray:
+        """(q̇₁, q̇₂): ``ω_rel = q̇₁ R_hᵀ a₁ + q̇₂ a₂`` (rad/s)."""
+        w = self.relative_twist(state)[:3]
+        return np.asarray(np.linalg.lstsq(self._axes_now(state), w, rcond=None)[0], dtype=float)
+
+    def coordinates(self, state: State) -> FloatArray:
+        """(q₁, q₂) with ``R_h = Rot(a₁, q₁) Rot(a₂, q₂)`` (rad)."""
+        R = self.relative_pose(state)[:3, :3]
+        a1, a2 = self.axis1, self.axis2
+        a3 = np.cross(a1, a2)
+        # in the basis (a1, a2, a3), R = Rx(q1) Ry(q2)
+        B = np.column_stack([a1, a2, a3])
+        Rb = B.T @ R @ B
+        return np.array([math.atan2(Rb[2, 1], Rb[1, 1]), math.atan2(Rb[0, 2], Rb[0, 0])])
