@@ -12,6 +12,7 @@ The flow: parts (bodies, constraints, force models, controllers) → :class:`Sys
 import sys as _sys
 
 from gmuk import (
+    actuators,
     attitude,
     constraints,
     control,
@@ -43,7 +44,7 @@ from gmuk.constraints import (
     TrackingErrorBound,
     VirtualPairT2,
 )
-from gmuk.control import Controller, MorseLyapunovController
+from gmuk.control import Controller, MorseLyapunovController, MRPFeedback
 from gmuk.crosscheck import check
 from gmuk.dynamics import spatial_inertia
 from gmuk.engine import integrate, integrators, solvers, uk
@@ -93,6 +94,7 @@ __all__ = [
     "InequalityConstraint",
     "Layout",
     "LinearSpringDamper",
+    "MRPFeedback",
     "MorseLyapunovController",
     "NonholonomicConstraint",
     "PlaneBound",
@@ -118,6 +120,7 @@ __all__ = [
     "UniformRotation",
     "VirtualPairT2",
     "__version__",
+    "actuators",
     "attitude",
     "check",
     "compile_loop",

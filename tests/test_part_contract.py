@@ -502,12 +502,66 @@ def _joint_force(cls: type) -> Callable[[np.random.Generator], Case]:
     return make
 
 
+def _mrp_feedback(rng: np.random.Generator) -> Case:
+    from gmuk.actuators import ReactionWheel
+
+    n = 3  # the compiled form's case (other counts run in Python: tests/control/test_mrp.py)
+    axes = list(_rotation(rng).T)
+    wheels = [
+        ReactionWheel(
+            g,
+            rng.uniform(0.01, 0.2),
+            max_torque=rng.uniform(0.05, 1.0) if rng.integers(0, 2) else np.inf,
+            max_speed=rng.uniform(50.0, 700.0),
+            friction=rng.uniform(0.0, 1e-3),
+        )
+        for g in axes
+    ]
+    I_B = _inertia(rng) * rng.uniform(100.0, 1e3)
+    ctl = gmuk.MRPFeedback(
+        "bus",
+        wheels,
+        K=rng.uniform(0.1, 10.0),
+        P=rng.uniform(1.0, 50.0),
+        inertia_B=I_B,
+        K_I=rng.uniform(0.0, 0.01) if rng.integers(0, 2) else 0.0,
+        integral_limit=rng.uniform(0.01, 1.0),
+        R_NR=_rotation(rng),
+    )
+    bus = gmuk.RigidBody("bus", 750.0, I_B)  # the contract compares forms, not the plant
+    sys = gmuk.System([bus], controllers=[ctl])
+    state = sys.state(
+        g={"bus": _pose(rng, np.zeros(3))},
+        V={"bus": np.r_[0.1 * rng.normal(size=3), 0.0, 0.0, 0.0]},
+        z=np.r_[rng.normal(size=n) * 5.0, rng.normal(size=3) * 0.5],
+        t=float(rng.uniform(0.0, 1e3)),
+    )
+    return Case(ctl, sys, state, modeled=rng.normal(size=6))
+
+
+def _wheel_motors(rng: np.random.Generator) -> Case:
+    from gmuk.actuators import ReactionWheel, WheelArray, WheelMotors
+
+    wheels = WheelArray(
+        [
+            ReactionWheel(g, rng.uniform(0.01, 0.2), friction=rng.uniform(0.0, 1e-3))
+            for g in _rotation(rng).T
+        ]
+    )
+    bus = gmuk.RigidBody("bus", 750.0, _inertia(rng) * 1e3)
+    bodies, cons = wheels.uk_parts(bus)
+    torques = rng.normal(size=3)
+    model = WheelMotors(bus, bodies, wheels, lambda t, R, w, s: torques)
+    return _case(rng, model, (bus, *bodies), (0, 10), 1.0, constraints=cons)
+
+
 def _baumgarte(rng: np.random.Generator) -> gmuk.Baumgarte | None:
     return None if rng.integers(0, 2) else gmuk.Baumgarte.critical(rng.uniform(0.01, 1.0))
 
 
 def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
     from gmuk import robots
+    from gmuk.actuators import WheelMotors
     from gmuk.forces.thesis_gravity import ThesisRadialHarmonicGravity
     from gmuk.optimize.result import OpenLoopControl
     from gmuk.scenarios.unmodeled import HarmonicPerturbation
@@ -531,6 +585,8 @@ def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
         gmuk.ConfigurationTrackingT2: _configuration_tracking_t2,
         gmuk.VirtualPairT2: _virtual_pair_t2,
         gmuk.RelativeConstraint: _relative_constraint,
+        gmuk.MRPFeedback: _mrp_feedback,
+        WheelMotors: _wheel_motors,
         **_environment_factories(),
         **{cls: _joint(cls) for cls in _joint_kinds()},
         robots.JointEffort: _joint_force(robots.JointEffort),
@@ -676,7 +732,9 @@ def check_controller(case: Case, forms: Forms) -> None:
         (body,) = ctl.bodies
         slot = state.layout.slot(body)
         kernel, params = term
-        a_model = np.array(modeled[slot.offset : slot.offset + 6])
+        a_model = (
+            np.zeros(6) if modeled is None else np.array(modeled[slot.offset : slot.offset + 6])
+        )
         out, zd = np.empty(6), np.empty(6)
         status = _control_at(
             kernel_address(kernel, CONTROL_KERNEL), state.t, np.array(state.pose(body)),

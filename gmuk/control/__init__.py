@@ -7,9 +7,11 @@ from gmuk.control.morse_lyapunov import (
     morse_s,
     morse_s_rate_matrix,
 )
+from gmuk.control.mrp import MRPFeedback
 
 __all__ = [
     "Controller",
+    "MRPFeedback",
     "MorseLyapunovController",
     "TrackingErrors",
     "morse_s",
