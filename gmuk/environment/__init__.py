@@ -14,7 +14,7 @@ ICRF-aligned axes (GCRS axes about the Earth), centred on the central body at N'
   pressure with the conical shadow (:func:`shadow_fraction`) of the Earth and the Moon.
 * :class:`AtmosphericDrag` with :class:`ExponentialAtmosphere` (Vallado's table).
 * :func:`earth_gravity`: the shipped EGM2008 field, oriented at an epoch.
-* :class:`EclipseEvent`: umbra or penumbra entry and exit, for :func:`gmuk.simulate`.
+* :class:`EclipseEvent`: umbra or penumbra entry and exit, for :meth:`gmuk.System.simulate`.
 """
 
 from gmuk.environment.drag import VALLADO_2013, AtmosphericDrag, ExponentialAtmosphere

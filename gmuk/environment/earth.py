@@ -7,10 +7,10 @@ reference (equatorial) radius 6378136.3 m of EGM2008 (Pavlis et al. 2012), rotat
 :func:`earth_gravity` gives the shipped EGM2008 field (to degree 70) as a
 :class:`gmuk.SphericalHarmonicGravity` on bodies, with the Earth's body-fixed frame turning
 uniformly about N's third axis at ω_E from its orientation at an epoch: the Earth Rotation
-Angle θ(epoch) (IAU 2000, ``eraEra00``, UT1 taken as UTC: |UT1 − UTC| < 0.9 s, i.e. under
+Angle θ(epoch) (IAU 2000, ``eraEra00``, UT1 taken as UTC: ``|UT1 − UTC| < 0.9 s``, i.e. under
 6.6e-5 rad). Precession, nutation and polar motion are not modelled: N's axes are the GCRS's,
 and the field's pole is N's third axis (the true pole is ~0.2° from it in the 2020s);
-the rotation is uniform (|ω_E − dθ/dt| = 1.5e-12 rad/s, 1.3e-7 rad a day).
+the rotation is uniform (``|ω_E − dθ/dt|`` = 1.5e-12 rad/s, 1.3e-7 rad a day).
 
 References
 ----------
@@ -52,7 +52,7 @@ __all__ = [
 
 def earth_rotation_angle(epoch: Epoch) -> float:
     """The Earth Rotation Angle θ (rad, in [0, 2π)) at ``epoch``, with UT1 taken as UTC
-    (IAU 2000, ``eraEra00``; error < 6.6e-5 rad from |UT1 − UTC| < 0.9 s)."""
+    (IAU 2000, ``eraEra00``; error < 6.6e-5 rad from ``|UT1 − UTC| < 0.9 s``)."""
     if not isinstance(epoch, Epoch):
         raise DefinitionError(f"epoch must be a gmuk.environment.Epoch; got {epoch!r}")
     u1, u2 = epoch.jd("utc")

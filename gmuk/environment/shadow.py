@@ -39,7 +39,7 @@ __all__ = ["margin_from_angles", "shadow_angles", "shadow_fraction", "shadow_mar
 def shadow_angles(r, s, o, R_sun, R_occ):  # type: ignore[no-untyped-def]
     """(a, b, c) (rad): the apparent radii of the Sun (centre s, radius R_sun) and of the
     occulter (centre o, radius R_occ) seen from r, and the angle between their centres; all
-    positions (3,) in one frame (m). c is taken as atan2(|u × w|, u · w), accurate at any
+    positions (3,) in one frame (m). c is taken as ``atan2(|u × w|, u · w)``, accurate at any
     angle. Returns b = -1 when r is inside the occulter or the Sun (no defined view)."""
     ux, uy, uz = s[0] - r[0], s[1] - r[1], s[2] - r[2]
     wx, wy, wz = o[0] - r[0], o[1] - r[1], o[2] - r[2]

@@ -69,7 +69,7 @@ _SRP_SYMBOLIC = "gmuk.optimize has no CasADi form of the ERFA ephemerides or of 
 def cannonball_srp_load(rigid, t, g, V, m, J, p, field, out):  # type: ignore[no-untyped-def]
     """:class:`CannonballSRP`'s kernel (signature ``FORCE_KERNEL``). Parameters
     ``p = (ν P₀ AU² C_R A, s_x, s_y, s_z)``: the pressure constant (N·m²… times the shadow
-    fraction ν) and the Sun's position s_N (m). Force ``k/ρ² (r − s)/ρ``, ρ = |r − s|, at
+    fraction ν) and the Sun's position s_N (m). Force ``k/ρ² (r − s)/ρ``, ``ρ = |r − s|``, at
     the centre of mass. Returns 0."""
     ux, uy, uz = g[0, 3] - p[1], g[1, 3] - p[2], g[2, 3] - p[3]
     rho = math.sqrt(ux * ux + uy * uy + uz * uz)
@@ -121,7 +121,7 @@ class Plate:
     area : float
         A (m²), > 0.
     normal_B : array_like, shape (3,)
-        Outward unit normal in the body frame (|n| = 1 to 1e-9; not normalised for you).
+        Outward unit normal in the body frame (``|n| = 1`` to 1e-9; not normalised for you).
         Only the side it points to is lit (a panel lit on both sides is two plates).
     specular, diffuse, absorbed : float
         The fractions C_s, C_d, C_a of the incoming light, each in [0, 1], summing to 1

@@ -185,7 +185,7 @@ class Epoch:
         return ((self.jd1_tdb - J2000_JD) + self.jd2_tdb) * DAY
 
     def tdb_minus_tt(self) -> float:
-        """TDB − TT at this instant (s), geocentric (``eraDtdb``; |·| < 1.7 ms)."""
+        """TDB − TT at this instant (s), geocentric (``eraDtdb``; below 1.7 ms in size)."""
         return _dtr(self.jd1_tdb, self.jd2_tdb)
 
     # ------------------------------------------------------------------ arithmetic
