@@ -4,6 +4,7 @@
     gmuk list
     gmuk plugins
     gmuk run [NAME] [--out DIR] [--no-plots] [--csv] [--format FMT] [--checkpoint-every S] [...]
+    gmuk run [NAME] --stop-at T [...]
     gmuk run [NAME] --resume DIR
     gmuk run NAME --help
     gmuk check [--seed S] [--samples N] [--verbose]
@@ -54,6 +55,11 @@ it ends (on a terminal, the simulation also shows a progress bar); ``summary.jso
 the step loop, ``compile``: compiling the parts' kernels on first use (both once per machine),
 ``simulation``: the rest of the scenario's run — and ``wall_time_s`` is the simulation's.
 ``--csv`` also writes the primary run as ``DIR/trajectory.csv``.
+
+Events (:mod:`gmuk.engine.events`): ``--stop-at T`` ends every simulation of the run at the
+time T (s) with a terminal event (status "terminated", the state at T as the last output);
+``summary.json``'s ``events`` lists, for each run that located any, its events (name, t,
+direction, terminal), those a scenario's own simulations define included.
 
 ``gmuk check`` prints the table of :func:`gmuk.check <gmuk.crosscheck.check>` and exits 0 if
 every quantity agrees with Pinocchio within its tolerance, 1 if any does not.
@@ -203,6 +209,14 @@ def _run_parser(scenario: Scenario) -> argparse.ArgumentParser:
         help="continue the run stopped or killed in DIR, with the options it was started with",
     )
     common.add_argument(
+        "--stop-at",
+        type=scenarios.non_negative_float,
+        default=None,
+        metavar="T",
+        help="end each simulation at the time T (s) with a terminal event (gmuk.Event); its "
+        "status is then 'terminated' (kept by --resume)",
+    )
+    common.add_argument(
         "--format",
         default="png",
         metavar="FMT[,FMT]",
@@ -335,6 +349,15 @@ def _resumed(
             "--resume takes the options and the output folder of the run it continues; "
             "give no other scenario option or --out"
         )
+    if args.stop_at is not None:
+        raise OptionError(
+            "--resume takes the --stop-at of the run it continues (from its run.json); give "
+            "no --stop-at"
+        )
+    stop_at = record.get("stop_at")
+    if stop_at is not None and not (isinstance(stop_at, (int, float)) and stop_at >= 0):
+        raise OptionError(f"--resume {str(out)!r}: {record_path} has a bad stop_at {stop_at!r}")
+    args.stop_at = stop_at
     resumed = scenarios.get(name)
     return resumed, resumed.parse_options(shown), out
 
@@ -409,12 +432,16 @@ def _run_owned(
         folder.mkdir()
         texts = {o.name: o.show(options[o.name]) for o in scenario.options}
         record = {"scenario": scenario.name, "options": texts}
+        if args.stop_at is not None:
+            record["stop_at"] = args.stop_at
         write_text_atomic(folder / "run.json", json.dumps(record, indent=2) + "\n")
     shown = ", ".join(f"{o.name}={o.show(options[o.name])}" for o in scenario.options)
     phases = _Phases(scenario.name)
     with phases.phase("loop", None):  # the step loop, loaded from numba's cache or compiled
         compile_loop()  # (once per machine, announced on stderr by compile_loop itself)
-    with runs.run_control(folder, every_s=every, resume=args.resume is not None) as control:
+    events = [] if args.stop_at is None else [_stop_at(args.stop_at)]
+    resume = args.resume is not None
+    with runs.run_control(folder, every_s=every, resume=resume, events=events) as control:
         with _stopping_signals(control) as received:
             with phases.phase("simulation", f"simulating{f' ({shown})' if shown else ''}"):
                 # the parts' kernels compile on first use (once per machine): timed apart
@@ -424,14 +451,15 @@ def _run_owned(
     phases.split("simulation", "compile", jit.duration if jit.done else 0.0)
     elapsed = phases.times["simulation"]
     primary = result.trajectories[result.primary]
-    stopped = [k for k, v in result.trajectories.items() if v.status not in ("success", "drifted")]
+    ended = ("success", "drifted", "terminated")
+    stopped = [k for k, v in result.trajectories.items() if v.status not in ended]
     # completed runs whose constraint drifted past simulate's drift_tol
     drifted = [k for k, v in result.trajectories.items() if v.status == "drifted"]
     with phases.phase("save", "writing trajectory.npz"):
         path = primary.save(out / "trajectory.npz")
     status = primary.status
-    if status == "success":
-        status = "partial" if stopped else "drifted" if drifted else "success"
+    if status in ("success", "terminated"):
+        status = "partial" if stopped else "drifted" if drifted else status
     summary = {
         "scenario": result.name,
         "status": status,
@@ -446,6 +474,7 @@ def _run_owned(
             for k, v in result.trajectories.items()
             if "constraint_violation" in v.stats
         },
+        **({"events": events_found} if (events_found := _events(result)) else {}),
         "options": {k: list(v) if isinstance(v, tuple) else v for k, v in options.items()},
         **({"orbits": options["orbits"]} if "orbits" in options else {}),
         "wall_time_s": elapsed,  # the simulation phase, as time_s["simulation"]
@@ -512,6 +541,23 @@ def _run_owned(
             print(f"{result.name}: run {k!r}: {result.trajectories[k].message}", file=sys.stderr)
         return EXIT_DRIFTED
     return 0
+
+
+def _stop_at(t_stop: float) -> Any:
+    """``--stop-at``'s terminal event: ``t − t_stop`` rising through zero."""
+    from gmuk.engine.events import Event
+
+    return Event(lambda t, state: t - t_stop, terminal=True, direction=1, name="stop_at")
+
+
+def _events(result: Any) -> dict[str, list[dict[str, Any]]]:
+    """``summary.json``'s ``events``: each run's located events (name, t, direction,
+    terminal), for the runs that located any."""
+    return {
+        key: [e.to_dict() for e in traj.events]
+        for key, traj in result.trajectories.items()
+        if traj.events
+    }
 
 
 def _cell(value: Any) -> str:

@@ -63,7 +63,7 @@ class EventRecord:
     name : str
         The event's name.
     t : float
-        The crossing time (s), located to 1e-13 s (or 4 ε |t|) on the step's continuous
+        The crossing time (s), located to 1e-13 s (or 4 ε abs(t)) on the step's continuous
         extension.
     direction : int
         +1: the function rose through zero; -1: it fell.

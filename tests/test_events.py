@@ -268,7 +268,7 @@ def test_bad_events_are_refused_with_what_came_in():
     with pytest.raises(SimulationError, match="event 'late' returned nan at t = "):
         system.simulate(state, (0.0, 1.0), events=late_nan)
     traj = system.simulate(state, (0.0, 1.0), events=late_nan, on_failure="return")
-    assert traj.status == "failed" and traj.t[-1] < 1.0
+    assert traj.status == "failed" and traj.t[-1] > 0.5  # the step that met the NaN is kept
     assert "event 'late' returned nan" in traj.message
 
 
@@ -322,3 +322,92 @@ def test_a_terminated_run_checkpoints_complete_and_resumes_without_integrating(t
         again = system.simulate(state, (0.0, 10.0), t_eval=t_eval)
     assert again.status == "terminated" and again.t.tobytes() == first.t.tobytes()
     assert [e.to_dict() for e in again.events] == [e.to_dict() for e in first.events]
+
+
+# --- the command line: --stop-at and summary.json ------------------------------------------
+
+
+def _throw_run(duration: float = 5.0):
+    """A ball thrown up at 3 m/s from 100 m, its top recorded (a scenario of this test)."""
+    from gmuk.scenarios import ScenarioResult
+
+    system, state = _ball()
+    top = Event(lambda t, s: s.velocity("ball")[2], name="top")
+    traj = system.simulate(state, (0.0, duration), t_eval=np.linspace(0.0, duration, 11),
+                           events=[top])  # fmt: skip
+    return ScenarioResult("throw", {"throw": traj}, "throw", {"height_m": float(traj.x[-1, 2])})
+
+
+def _throw_scenario():
+    from gmuk.scenarios import Option, Scenario
+
+    return Scenario(
+        "throw", "a ball thrown up", _throw_run, lambda result, out, formats: [],
+        options=(Option("duration", float, 5.0, "simulated time (s)"),),
+    )  # fmt: skip
+
+
+THROW = _throw_scenario()
+
+
+@pytest.fixture
+def throw(monkeypatch):
+    from gmuk import scenarios
+
+    monkeypatch.setitem(scenarios.SCENARIOS, "throw", f"{__name__}:THROW")
+    scenarios.refresh()
+    yield
+    scenarios.refresh()
+
+
+def test_gmuk_run_stop_at_ends_the_run_there_and_summary_json_lists_the_events(
+    throw, tmp_path, capsys
+):
+    from gmuk import cli
+
+    out = tmp_path / "run"
+    assert cli.main(["run", "throw", "--stop-at", "1.5", "--no-plots", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "terminated" and summary["t_reached_s"] == pytest.approx(1.5)
+    top, stop = summary["events"]["throw"]
+    assert (top["name"], top["direction"], top["terminal"]) == ("top", -1, False)
+    assert top["t"] == pytest.approx(3.0 / G, abs=1e-12)
+    assert (stop["name"], stop["direction"], stop["terminal"]) == ("stop_at", 1, True)
+    assert abs(stop["t"] - 1.5) <= 1e-13
+    traj = gmuk.load_trajectory(out / "trajectory.npz")
+    assert traj.status == "terminated" and traj.t[-1] == stop["t"]
+    assert not (out / ".checkpoints").exists()  # complete: the checkpoints are spent
+    # without --stop-at: the whole span, the scenario's own event only
+    assert cli.main(["run", "throw", "--no-plots", "--out", str(tmp_path / "full")]) == 0
+    full = json.loads((tmp_path / "full" / "summary.json").read_text())
+    assert full["status"] == "success" and [e["name"] for e in full["events"]["throw"]] == ["top"]
+    # --resume takes the stop time the run was started with (its run.json), never a new one
+    out.mkdir(exist_ok=True)
+    (out / ".checkpoints").mkdir()
+    (out / ".checkpoints" / "run.json").write_text(json.dumps({"scenario": "throw",
+                                                               "options": {}}))  # fmt: skip
+    assert cli.main(["run", "--resume", str(out), "--stop-at", "2"]) == 2
+    assert "give no --stop-at" in capsys.readouterr().err
+    killed = tmp_path / "killed"  # a run killed before its first checkpoint
+    (killed / ".checkpoints").mkdir(parents=True)
+    record = {"scenario": "throw", "options": {"duration": "5"}, "stop_at": 1.5}
+    (killed / ".checkpoints" / "run.json").write_text(json.dumps(record))
+    assert cli.main(["run", "--resume", str(killed), "--no-plots"]) == 0
+    again = json.loads((killed / "summary.json").read_text())
+    assert again["status"] == "terminated" and again["events"] == summary["events"]
+
+
+def test_the_docs_page_runs_as_written_and_prints_what_it_says(capsys):
+    import re
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "events.rst").read_text()
+    blocks = re.findall(r"^\.\. code-block:: python\n\n((?:(?: {3}.*)?\n)+)", page, re.M)
+    assert blocks
+    namespace: dict = {}
+    for i, block in enumerate(blocks):
+        code = "\n".join(line[3:] for line in block.splitlines())
+        exec(compile(code, f"docs/events.rst, block {i}", "exec"), namespace)
+    printed = capsys.readouterr().out.strip()
+    assert f"which prints ``{printed}``" in " ".join(page.split())
+    assert namespace["traj"].status == "terminated"

@@ -47,7 +47,7 @@ if TYPE_CHECKING:
 __all__ = ["XTOL", "AltitudeEvent", "ApsisEvent", "Event", "EventRecord", "check_events"]
 
 #: Brent's method stops when the bracket of the crossing time is this small (s), or at the
-#: resolution of a double near t (4 ε |t|) for large times.
+#: resolution of a double near t (4 ε abs(t)) for large times.
 XTOL = 1e-13
 
 

@@ -108,6 +108,21 @@ class _Packing:
         Y[self.s_z] = state.z
         return Y
 
+    def adopt(self, t: float, Y: FloatArray, G0: FloatArray) -> State:
+        """:meth:`state` without the State constructor's checks and copies (its arrays are
+        fresh: the State takes them over)."""
+        xi = Y[self.s_xi].reshape(-1, 6)
+        g = _kernels.compose_exp(G0, xi) if self.nr else G0.copy()
+        return State._adopt(
+            t,
+            g,
+            Y[self.s_V].reshape(-1, 6).copy(),
+            Y[self.s_x].copy(),
+            Y[self.s_xd].copy(),
+            Y[self.s_z].copy(),
+            self.layout,
+        )
+
     def state(self, t: float, Y: FloatArray, G0: FloatArray) -> State:
         xi = Y[self.s_xi].reshape(-1, 6)
         g = _kernels.compose_exp(G0, xi) if self.nr else G0
@@ -720,8 +735,6 @@ class _Loop:
         self.method = run.method
         # Events: the loop hands back every step (a chunk of one), whose end Python checks.
         self.events = events
-        if events:
-            self.chunk = 1
         self.terminal: EventRecord | None = None
         self.n_event_rhs = 0
         self.g_prev: list[float] = []  # the events' values at the last accepted step
@@ -853,30 +866,18 @@ class _Loop:
         f0, aux = np.empty(n), np.empty(prog.n_aux)
         cap = self.chunk + 1
         bufs = self._buffers(cap, n, p.layout.n_rigid, prog.n_aux)
-        if self.events:  # the events' values at the start (a resumed run: at its step)
+        if self.events:  # their values at the start (a resumed run: at its step)
             start_state = state0 if resume is None else p.state(t, Y, G0)
             self.g_prev = [event_value(e, t, start_state) for e in self.events]
+            drive = (prog, fs, ints, Y, G0, f0, aux, out_arr, outs is not None)
+            return self._run_events(rec, bar, drive)
         while True:
             ints[_compiled.I_WRITTEN] = 0
-            if self.events:  # the step's start, for locating events in it
-                begun = bool(ints[_compiled.I_STARTED])
-                start = (
-                    float(fs[_compiled.F_T]),
-                    Y.copy(),
-                    G0.copy(),
-                    f0.copy() if begun else None,
-                )
-                steps_before = int(ints[_compiled.I_STEPS])
             status = _compiled.advance(
                 prog.parts, prog.method, fs, ints, Y, G0, f0, aux,
                 out_arr, outs is not None, *bufs,
             )  # fmt: skip
             n_out = int(ints[_compiled.I_WRITTEN])
-            if self.events and int(ints[_compiled.I_STEPS]) > steps_before:
-                block = self._block(n_out, bufs, prog) if n_out else None
-                if self._step_events(rec, prog, start, fs, ints, Y, G0, block):
-                    bar.update(self.t)
-                    return
             if n_out:
                 rec.add_block(self._block(n_out, bufs, prog))
             self.t = float(fs[_compiled.F_T])
@@ -896,6 +897,93 @@ class _Loop:
                 bufs = self._buffers(cap, n, p.layout.n_rigid, prog.n_aux)
             self._after_chunk()
 
+    def _run_events(self, rec: _Recorder, bar: _Progress, drive: tuple[Any, ...]) -> None:
+        """:meth:`run` with events: the loop takes one step per call and Python looks at the
+        events at its end (:meth:`_step_events`). The outputs stay in the buffers for up to
+        :attr:`chunk` steps, as without events, and are drained then (:meth:`_drain`), at
+        the end, at a terminal event, on a stop request or a failure."""
+        prog, fs, ints, Y, G0, f0, aux, out_arr, has_outs = drive
+        p, C = self.p, _compiled
+        n = Y.size
+        ints[C.I_CHUNK] = 1
+        ints[C.I_WRITTEN] = 0
+        cap = self.chunk + 1
+        bufs = self._buffers(cap, n, p.layout.n_rigid, prog.n_aux)
+        pending = 0  # steps since the last drain
+        while True:
+            begun = bool(ints[C.I_STARTED])
+            start = (float(fs[C.F_T]), Y.copy(), G0.copy(), f0.copy() if begun else None)
+            steps_before = int(ints[C.I_STEPS])
+            status = C.advance(
+                prog.parts, prog.method, fs, ints, Y, G0, f0, aux, out_arr, has_outs, *bufs
+            )
+            if int(ints[C.I_STEPS]) > steps_before:
+                pending += 1
+                try:
+                    term = self._step_events(rec, prog, start, fs, ints, Y, G0)
+                except BaseException:  # the step is kept, then the failure reported
+                    self._drain(rec, bufs, prog, fs, ints, Y, G0, bar)
+                    raise
+                if term is not None:
+                    self._drain(rec, bufs, prog, fs, ints, Y, G0, bar, term)
+                    return
+            stop = self.control is not None and self.control.stop_requested
+            if status == C.PAUSE and pending < self.chunk and not stop:
+                continue
+            rows = int(ints[C.I_WRITTEN])
+            self._drain(rec, bufs, prog, fs, ints, Y, G0, bar)
+            pending = 0
+            if status == C.DONE:
+                return
+            if status < 0:
+                raise self._failure(status, prog, fs, ints)
+            if status == C.FULL and rows == 0:  # one step has more outputs than room
+                cap = 2 * int(ints[C.I_NEED]) + cap
+                bufs = self._buffers(cap, n, p.layout.n_rigid, prog.n_aux)
+            self._after_chunk()
+
+    def _drain(
+        self,
+        rec: _Recorder,
+        bufs: _Buffers,
+        prog: _program.Program,
+        fs: FloatArray,
+        ints: np.ndarray,
+        Y: FloatArray,
+        G0: FloatArray,
+        bar: _Progress,
+        term: EventRecord | None = None,
+    ) -> None:
+        """The buffered outputs to the recorder and the loop's state to ``self`` (counters,
+        time, the checkpoint's step). With a terminal event ``term``: only the outputs
+        before it, then its state, where the run ends."""
+        C = _compiled
+        rows = int(ints[C.I_WRITTEN])
+        dropped = 0
+        if rows:
+            block = self._block(rows, bufs, prog)
+            if term is not None:
+                keep = block["t"] < term.t
+                dropped = rows - int(keep.sum())
+                block = {name: col[keep] for name, col in block.items()}
+            rec.add_block(block)
+        ints[C.I_WRITTEN] = 0
+        self.n_rhs = int(ints[C.I_RHS])
+        self.n_steps = int(ints[C.I_STEPS])
+        self.n_rejected = int(ints[C.I_REJECTED])
+        h = float(fs[C.F_H])
+        if term is not None:
+            rec.add(term.state)
+            out_i = 0 if self.run_args.outs is None else int(ints[C.I_OUT]) - dropped
+            self.at = (self.p.pack(term.state), term.state.g.copy(), h, out_i)
+            self.t = term.t
+            self.terminal = term
+        else:
+            self.t = float(fs[C.F_T])
+            if ints[C.I_STARTED]:
+                self.at = (Y.copy(), G0.copy(), h, int(ints[C.I_OUT]))
+        bar.update(self.t)
+
     def _step_events(
         self,
         rec: _Recorder,
@@ -905,16 +993,14 @@ class _Loop:
         ints: np.ndarray,
         Y: FloatArray,
         G0: FloatArray,
-        block: dict[str, Any] | None,
-    ) -> bool:
+    ) -> EventRecord | None:
         """The events of the step just accepted, from ``start`` (t, Y, G0, f0) to the loop's
         (fs[F_T], Y, G0): each whose value changed sign (in its direction) is located and
-        recorded; the first terminal one ends the run there (its state the last output, the
-        step's later outputs dropped). Returns whether a terminal event ended the run; the
-        step's outputs are the caller's to add otherwise."""
+        recorded in ``rec.events``, in time order. Returns the first terminal one (the run
+        ends there; recorded events after it are dropped), or None."""
         p = self.p
         t1 = float(fs[_compiled.F_T])
-        end = p.state(t1, Y, G0)
+        end = p.adopt(t1, Y, G0)
         values = [event_value(e, t1, end) for e in self.events]
         crossed = []
         for e, g0, g1 in zip(self.events, self.g_prev, values, strict=True):
@@ -923,7 +1009,7 @@ class _Loop:
                 crossed.append((e, 1 if rising else -1))
         self.g_prev = values
         if not crossed:
-            return False
+            return None
         at = self._continuous(prog, start, t1, fs, ints)
         found = []
         for e, way in crossed:
@@ -933,31 +1019,10 @@ class _Loop:
         term = next((r for r in found if r.terminal), None)
         if term is None:
             rec.events.extend(found)
-            return False
+            return None
         rec.events.extend(r for r in found if r.t <= term.t and not r.terminal)
         rec.events.append(term)
-        kept = 0
-        if block is not None:
-            keep = block["t"] < term.t
-            kept = int(keep.sum())
-            if kept:
-                rec.add_block({name: col[keep] for name, col in block.items()})
-        rec.add(term.state)
-        # where the run ended, for its (complete) checkpoint
-        out_i = (
-            0
-            if self.run_args.outs is None
-            else int(ints[_compiled.I_OUT])
-            - (int(block["t"].size) - kept if block is not None else 0)
-        )
-        Y_e = p.pack(term.state)
-        self.at = (Y_e, term.state.g.copy(), float(fs[_compiled.F_H]), out_i)
-        self.t = term.t
-        self.n_rhs = int(ints[_compiled.I_RHS])
-        self.n_steps = int(ints[_compiled.I_STEPS])
-        self.n_rejected = int(ints[_compiled.I_REJECTED])
-        self.terminal = term
-        return True
+        return term
 
     def _continuous(
         self,
