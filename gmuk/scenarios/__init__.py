@@ -78,6 +78,7 @@ SCENARIOS: dict[str, str] = {
     "smd-bi": "gmuk.scenarios.smd:BI",
     "smd-compare": "gmuk.scenarios.smd_compare:SCENARIO",
     "maintenance": "gmuk.scenarios.maintenance:SCENARIO",
+    "rw-pointing": "gmuk.scenarios.rw_pointing:SCENARIO",
 }
 
 #: Entry-point group through which other packages register scenarios.
