@@ -39,16 +39,17 @@ import os
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import argparse  # noqa: E402
-import statistics  # noqa: E402
-import time  # noqa: E402
-from typing import Any  # noqa: E402
+import argparse
+import itertools
+import statistics
+import time
+from typing import Any
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from gmuk.attitude import R_NB_from_mrp  # noqa: E402
-from gmuk.lie import so3  # noqa: E402
-from gmuk.scenarios import rw_pointing as rw  # noqa: E402
+from gmuk.attitude import R_NB_from_mrp
+from gmuk.lie import so3
+from gmuk.scenarios import rw_pointing as rw
 
 DURATION = 600.0
 
@@ -162,7 +163,7 @@ def main() -> None:
     print("and [against itself at dt/2]:")
     runs = {dt: basilisk_run(dt) for dt in (0.1, 0.05, 0.025, 0.0125, 0.00625)}
     dts = sorted(runs, reverse=True)
-    for a, b in zip(dts, dts[1:], strict=False):
+    for a, b in itertools.pairwise(dts):
         print(fmt.format(f"dt = {a:g} s", *distance(runs[a], ref)))
         print(fmt.format(f"[dt = {a:g} vs {b:g} s]", *distance(runs[a], runs[b])))
     print(fmt.format(f"dt = {dts[-1]:g} s", *distance(runs[dts[-1]], ref)))
