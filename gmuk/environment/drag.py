@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._casadi import casadi
 from gmuk._forms import Forms
 from gmuk._numba import njit
 from gmuk._validation import FloatArray, real_number
@@ -141,6 +142,17 @@ class ExponentialAtmosphere:
         self.table = tuple(tuple(float(v) for v in r) for r in rows)
         self._data = data
 
+    def casadi_density(self, h: Any) -> Any:
+        """ρ(h) (kg/m³) of a CasADi altitude h (m): the bands of :func:`exponential_density`
+        as a chain of ``if_else`` (the band of the largest h₀ ≤ h; no check below 0 m)."""
+        ca = casadi()
+        d = self._data
+        rho = d[1] * ca.exp(-(h - d[0]) / d[2])
+        for k in range(1, d.shape[0] // 3):
+            band = d[3 * k + 1] * ca.exp(-(h - d[3 * k]) / d[3 * k + 2])
+            rho = ca.if_else(h >= d[3 * k], band, rho)
+        return rho
+
     def density(self, h: Any) -> FloatArray:
         """ρ (kg/m³) at altitude h (m), scalar or array; a DomainError below 0 m."""
         hs = np.asarray(h, dtype=float)
@@ -183,10 +195,7 @@ class AtmosphericDrag(ForceModel):
     """
 
     _kernel = staticmethod(drag_load)
-    _forms = Forms(
-        compiled=True,
-        symbolic="not written yet: the table's band choice would be a chain of CasADi if_else",
-    )
+    _forms = Forms(compiled=True, symbolic=True)
 
     def __init__(
         self,
@@ -218,6 +227,24 @@ class AtmosphericDrag(ForceModel):
     def force(self, t: float, r_N: FloatArray, v_N: FloatArray, body: Body) -> FloatArray:
         """f_N (N) (:func:`drag_load`)."""
         return self._kernel_load(False, t, r_N, v_N, body)
+
+    def casadi_force(self, t: Any, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force` (CasADi, 3×1, N): :func:`drag_load`'s formula
+        with the density of :meth:`ExponentialAtmosphere.casadi_density`."""
+        ca = casadi()
+        h = ca.norm_2(r_N) - self.radius
+        w = r_N[0] * self.rotation_rate
+        v_rel = ca.vertcat(v_N[0] + self.rotation_rate * r_N[1], v_N[1] - w, v_N[2])
+        k = -0.5 * self.C_D * self.area * self.atmosphere.casadi_density(h)
+        return k * ca.norm_2(v_rel) * v_rel
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` (CasADi, 6×1): ``[0; Rᵀ f_N]`` with
+        f_N = :meth:`casadi_force` at the centre of mass, v_N = R V_B[3:]."""
+        ca = casadi()
+        R = g_NB[:3, :3]
+        f_N = AtmosphericDrag.casadi_force(self, t, g_NB[:3, 3], R @ V_B[3:], body)
+        return ca.vertcat(ca.DM.zeros(3, 1), R.T @ f_N)
 
     def _kernel_params(self, body: Body) -> tuple[tuple[float, ...], Any]:
         return (self.C_D * self.area, self.rotation_rate, self.radius), self.atmosphere._data

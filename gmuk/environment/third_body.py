@@ -31,14 +31,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._casadi import casadi
 from gmuk._forms import Forms
 from gmuk._numba import njit
 from gmuk._validation import FloatArray, real_number, real_vector
 from gmuk.environment._loads import call_load
 from gmuk.environment.ephemeris import MU, Ephemeris, _body
 from gmuk.environment.time import Epoch
+from gmuk.errors import DefinitionError
 from gmuk.forces.base import ForceModel
-from gmuk.forces.gravity import gravity_gradient_wrench
+from gmuk.forces.gravity import GravityGradient, gravity_gradient_wrench
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
@@ -155,7 +157,7 @@ class ThirdBodyPerturbation(ForceModel):
             "the compiled loop cannot call; the physics is one numba kernel (third_body_load) "
             "that the Python form calls with that position"
         ),
-        symbolic="gmuk.optimize has no CasADi form of the ERFA ephemerides",
+        symbolic=True,
     )
 
     def __init__(
@@ -177,6 +179,48 @@ class ThirdBodyPerturbation(ForceModel):
     def epoch(self) -> Epoch:
         """The instant of t = 0."""
         return self.ephemeris.epoch
+
+    def _numeric_time(self, t: Any) -> float:
+        """t as a float for the ephemeris; a DefinitionError for a symbolic (CasADi) time."""
+        ca = casadi()
+        if isinstance(t, (ca.SX, ca.MX)):
+            raise DefinitionError(
+                f"{self.name}: the symbolic (CasADi) form of ThirdBodyPerturbation takes numeric "
+                "times only (the perturber's position is ERFA's series at epoch + t); "
+                "gmuk.optimize then transcribes element by element with the nodes' times"
+            )
+        return float(t)
+
+    def casadi_force(self, t: Any, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force` at a numeric time t (CasADi, 3×1, N): Battin's
+        tidal acceleration as :func:`battin_tidal` writes it, times the mass.
+
+        Raises
+        ------
+        DefinitionError
+            For a symbolic t.
+        """
+        ca = casadi()
+        d = ca.DM(self.ephemeris(self._numeric_time(t)))
+        q = ca.dot(r_N, r_N - 2.0 * d) / ca.dot(d, d)
+        F = q * (3.0 + q * (3.0 + q)) / (1.0 + (1.0 + q) ** 1.5)
+        rho = ca.norm_2(d - r_N)
+        return (-self.mu * body.mass / (rho * rho * rho)) * (r_N + F * d)
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` at a numeric time t (CasADi, 6×1; N·m, N):
+        Eq. 23 at r − d (:meth:`gmuk.GravityGradient.casadi_wrench`, the CasADi form of
+        :func:`gravity_gradient_wrench`) for the torque and the finite-size force, plus the
+        tidal force :meth:`casadi_force` at the centre of mass, as :func:`third_body_load`."""
+        ca = casadi()
+        d = ca.DM(self.ephemeris(self._numeric_time(t)))
+        R, r = g_NB[:3, :3], g_NB[:3, 3]
+        g_s = ca.vertcat(ca.horzcat(R, r - d), ca.DM([[0.0, 0.0, 0.0, 1.0]]))
+        w = GravityGradient.casadi_wrench(self, t, g_s, V_B, body)  # type: ignore[arg-type]
+        rho = ca.norm_2(r - d)
+        finite = w[3:] + (self.mu * body.mass / (rho * rho * rho)) * (R.T @ (r - d))
+        f_cm = R.T @ ThirdBodyPerturbation.casadi_force(self, t, r, None, body)
+        return ca.vertcat(w[:3], f_cm + finite)
 
     def _params(self, t: float) -> tuple[float, ...]:
         d = self.ephemeris(t)

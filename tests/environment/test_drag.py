@@ -109,3 +109,12 @@ def test_bad_coefficients_are_refused():
         AtmosphericDrag(-1.0, 1.0)
     with pytest.raises(DefinitionError, match="atmosphere must be"):
         AtmosphericDrag(2.2, 1.0, atmosphere=VALLADO_2013)  # type: ignore[arg-type]
+
+
+def test_symbolic_density_picks_the_same_band_as_the_kernel():
+    ca = pytest.importorskip("casadi")
+    atm = ExponentialAtmosphere()
+    h = ca.SX.sym("h")
+    fn = ca.Function("rho", [h], [atm.casadi_density(h)])
+    for km in (0.0, 24.999, 25.0, 149.0, 150.0, 399.9, 400.0, 999.0, 1000.0, 1500.0):
+        assert float(fn(km * 1e3)) == pytest.approx(float(atm.density(km * 1e3)), rel=1e-14)

@@ -150,3 +150,14 @@ def test_bad_definitions_are_refused():
         ThirdBodyPerturbation("earth", EPOCH)
     with pytest.raises(DefinitionError, match="Epoch"):
         ThirdBodyPerturbation("sun", "2024-01-01")
+
+
+def test_symbolic_form_needs_a_numeric_time():
+    ca = pytest.importorskip("casadi")
+    model = ThirdBodyPerturbation("sun", EPOCH)
+    sat = gmuk.PointMass("sat", 10.0)
+    with pytest.raises(DefinitionError, match="numeric times only"):
+        model.casadi_force(ca.SX.sym("t"), ca.SX.sym("r", 3), ca.SX.sym("v", 3), sat)
+    r = np.array([7.0e6, 0.0, 1.0e6])
+    f = np.asarray(ca.DM(model.casadi_force(30.0, ca.DM(r), None, sat))).ravel()
+    np.testing.assert_allclose(f, model.force(30.0, r, np.zeros(3), sat), rtol=1e-13)
