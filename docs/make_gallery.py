@@ -173,6 +173,33 @@ COMMANDS: dict[str, tuple[str, str, list[tuple[str, str]], str]] = {
         ],
         "scenarios/chapter6",
     ),
+    "four-bar": (
+        "",
+        "none (beyond the thesis: closed loops of robot joints, issue #28)",
+        [
+            ("angles", "Crank and rocker angles of the free four-bar under gravity."),
+            ("closure_energy", "Freudenstein's residual of the loop and the energy drift."),
+        ],
+        "robotics_loops",
+    ),
+    "stewart": (
+        "",
+        "none (beyond the thesis: closed loops of robot joints, issue #28)",
+        [("sag_forces", "Platform sag and leg forces under gravity with PD legs.")],
+        "robotics_loops",
+    ),
+    "panda": (
+        "",
+        "none (beyond the thesis: robots, issue #28)",
+        [
+            (
+                "panda_joints",
+                "The Panda's joint angles, their difference from Pinocchio's ABA (DOP853 at "
+                "1e-12), and the mechanical energy its damped joints dissipate.",
+            ),
+        ],
+        "robotics",
+    ),
 }
 
 

@@ -436,6 +436,7 @@ RUNS: dict[str, Run] = {
     "optimize-table": Run(
         "(benchmarks/bench_optimize.py --table)", seconds=25, function=_optimize_table
     ),
+    "panda": Run("panda", seconds=6),
 }
 
 
@@ -785,6 +786,14 @@ def _add(doc: str, run: str, *rows: tuple[Any, ...]) -> None:
         offset = next((float(x) for x in rest[1:] if isinstance(x, (int, float))), None)
         FIGURES.append(Figure(doc, text, run, key, fmt, near, kind, offset))
 
+
+# docs/robotics.rst -----------------------------------------------------------------------------
+_add(
+    "docs/robotics.rst",
+    "panda",
+    ("3.1e-10 rad", "pinocchio_max_q_difference_rad", "{:.1e} rad", "within"),
+    ("84.5 J", "energy_dissipated_J", "{:.1f} J", "dissipate"),
+)
 
 # docs/view.rst ---------------------------------------------------------------------------------
 _add(

@@ -522,7 +522,9 @@ class RevoluteJoint(Joint):
     Parameters
     ----------
     axis : array_like (3,), optional
-    (the others as :class:`Joint`)
+        The rotation axis, in both joint frames (normalised here).
+    **kw
+        ``parent_frame``, ``child_frame``, ``baumgarte``, ``name``, as for :class:`Joint`.
     """
 
     kind = "revolute"

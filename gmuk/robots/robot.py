@@ -18,6 +18,7 @@ stay [ω; v] in the body frame (docs/robotics.rst, "Conventions beside Pinocchio
 
 from __future__ import annotations
 
+import copy
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -25,13 +26,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from gmuk._validation import FloatArray, as_array
+from gmuk._validation import FloatArray, as_array, real_number
 from gmuk.bodies import RigidBody
 from gmuk.engine.system import System
 from gmuk.errors import DefinitionError, GmukError
 from gmuk.forces.mechanical import UniformGravity
 from gmuk.lie import se3
-from gmuk.robots.forces import JointEffort
+from gmuk.robots.forces import JointEffort, JointSpringDamper
 from gmuk.robots.joints import (
     Joint,
     PlanarJoint,
@@ -191,6 +192,7 @@ class Robot:
         package_dirs: Sequence[str] | None = None,
         *,
         gravity: Any = None,
+        damping: float = 0.0,
         forces: Sequence[ForceModel] = (),
         baumgarte: Baumgarte | None = None,
         **system_options: Any,
@@ -212,6 +214,9 @@ class Robot:
             mesh).
         gravity : array_like (3,), optional
             g in N (m/s²); Pinocchio's default (0, 0, −9.81) if omitted; zeros for none.
+        damping : float
+            Viscous damping c ≥ 0 on every joint's rates (N·m·s/rad, N·s/m): a
+            :class:`~gmuk.robots.JointSpringDamper` per joint when c > 0.
         forces : sequence of ForceModel
             More force models on the robot's bodies.
         baumgarte : Baumgarte, optional
@@ -259,7 +264,7 @@ class Robot:
             )
         if gravity is not None:
             model.gravity.linear = as_array(gravity, (3,), "gravity", batch=False)
-        return cls(
+        robot = cls(
             model,
             base=base,
             forces=forces,
@@ -268,10 +273,24 @@ class Robot:
             path=p,
             **system_options,
         )
+        c = real_number(damping, "damping", non_negative=True)
+        if c > 0.0:
+            robot = robot.with_forces(
+                [JointSpringDamper(j, damping=c) for j in robot.joints.values()]
+            )
+        return robot
 
     def _build_system(self, extra: Sequence[ForceModel]) -> System:
         forces = [*([self._weight] if self._weight is not None else []), *self._forces, *extra]
         return System(list(self.bodies), list(self.joints.values()), forces, **self._system_options)
+
+    def with_forces(self, forces: Sequence[ForceModel]) -> Robot:
+        """The same robot with more force models (on its bodies or joints) in its System."""
+        new = copy.copy(self)
+        new._forces = (*self._forces, *forces)
+        new.system = new._build_system(())
+        new._pin_data = _pin().Data(self.model)
+        return new
 
     def with_parts(
         self,

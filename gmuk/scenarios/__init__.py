@@ -79,6 +79,9 @@ SCENARIOS: dict[str, str] = {
     "smd-compare": "gmuk.scenarios.smd_compare:SCENARIO",
     "maintenance": "gmuk.scenarios.maintenance:SCENARIO",
     "rw-pointing": "gmuk.scenarios.rw_pointing:SCENARIO",
+    "four-bar": "gmuk.scenarios.four_bar:SCENARIO",
+    "stewart": "gmuk.scenarios.stewart:SCENARIO",
+    "panda": "gmuk.scenarios.panda:SCENARIO",
 }
 
 #: Entry-point group through which other packages register scenarios.
