@@ -1,4 +1,5 @@
-"""The rw-pointing spacecraft in both wheel forms, for the actuator and controller tests.
+"""The rw-pointing spacecraft (gmuk/scenarios/rw_pointing.py) in both wheel forms, with
+friction and the motors as options, for the actuator tests.
 
 Issue #29, item 7: I_B = diag(900, 800, 600) kg·m² with the wheels locked, three wheels on
 the body axes with J_s = 50 / (6000 rpm) kg·m², motor limit 0.2 N·m, speeds 100, 200,
@@ -15,14 +16,15 @@ import numpy as np
 import gmuk
 from gmuk.actuators import ReactionWheel, WheelArray, WheelMotors
 from gmuk.attitude import R_NB_from_mrp
+from gmuk.scenarios import rw_pointing
 
-RPM = 2.0 * np.pi / 60.0
-I_B = np.diag([900.0, 800.0, 600.0])
-J_S = 50.0 / (6000.0 * RPM)
-SIGMA0 = np.array([0.1, 0.2, -0.3])
-OMEGA0 = np.array([0.001, -0.01, 0.03])
-SPEEDS0 = np.array([100.0, 200.0, 300.0]) * RPM
-MASS = 750.0
+RPM = rw_pointing.RPM
+I_B = rw_pointing.INERTIA_B
+J_S = rw_pointing.SPIN_INERTIA
+SIGMA0 = rw_pointing.SIGMA0
+OMEGA0 = rw_pointing.OMEGA0
+SPEEDS0 = rw_pointing.SPEEDS0
+MASS = rw_pointing.MASS
 
 
 def wheels(friction: float = 0.0, max_torque: float = 0.2) -> WheelArray:
