@@ -3,6 +3,7 @@
 Run on demand (not a test):
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_events.py [--repeats 5]
+        [--orbits 20] [--no-events] [--first-event]
 
 A point mass on a Keplerian orbit (e = 0.3, a = 7000 km, point-mass gravity, compiled) over
 20 orbits, DOP853 at rtol = atol = 1e-10, every step an output or 2001 output times: without
@@ -54,8 +55,22 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--orbits", type=float, default=20.0)
+    ap.add_argument("--no-events", action="store_true", help="time the run without events only")
+    ap.add_argument(
+        "--first-event",
+        action="store_true",
+        help="time only the first located event of this process (its helpers compiled, or "
+        "loaded from numba's cache); remove gmuk/engine/integrators/__pycache__/_event_step.* "
+        "first for the cold figure",
+    )
     args = ap.parse_args()
     system, state, period = kepler()
+    if args.first_event:
+        system.simulate(state, (0.0, 0.1 * period))  # the loop loaded first
+        t0 = time.perf_counter()
+        traj = system.simulate(state, (0.0, period), events=[gmuk.ApsisEvent("sat")])
+        print(f"first located event: {time.perf_counter() - t0:.2f} s ({len(traj.events)} event)")
+        return
     span = (0.0, args.orbits * period)
     has_events = "events" in inspect.signature(system.simulate).parameters
     never = None
@@ -67,7 +82,7 @@ def main() -> None:
     for outputs in ("every step", "2001 times"):
         t_eval = None if outputs == "every step" else np.linspace(*span, 2001)
         cases = [("none", None)]
-        if has_events:
+        if has_events and not args.no_events:
             cases += [("ApsisEvent both", gmuk.ApsisEvent("sat", kind="both")),
                       ("never crosses", never)]  # fmt: skip
         ref = None

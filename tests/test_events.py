@@ -411,3 +411,44 @@ def test_the_docs_page_runs_as_written_and_prints_what_it_says(capsys):
     printed = capsys.readouterr().out.strip()
     assert f"which prints ``{printed}``" in " ".join(page.split())
     assert namespace["traj"].status == "terminated"
+
+
+class _PythonWeight(gmuk.ForceModel):
+    """m g_N written in Python (no compiled form): the loop calls it back, also while an
+    event is located."""
+
+    def force(self, t, r_N, v_N, body):
+        return body.mass * np.array([0.0, 0.0, -G])
+
+
+def test_events_are_located_with_parts_evaluated_in_python():
+    ball = gmuk.PointMass("ball", mass=2.0)
+    system = gmuk.System(bodies=[ball], forces=[_PythonWeight()])
+    state = system.state(r={"ball": [0.0, 0.0, 100.0]}, v={"ball": [1.0, 0.0, 3.0]})
+    traj = system.simulate(state, (0.0, 10.0), events=[_ground(terminal=True, direction=-1)])
+    assert traj.status == "terminated"
+    assert abs(traj.t[-1] - _impact_time()) <= 1e-12 * _impact_time()
+    assert traj.stats["n_event_rhs"] > 0
+
+
+class _FailingWeight(_PythonWeight):
+    """Fails at any time that is not a multiple of 0.5 s: never in the steps of RK4 with a
+    step of 1 s (stages at t, t + 0.5, t + 1), always when an event is located in one."""
+
+    def force(self, t, r_N, v_N, body):
+        if 2.0 * t != round(2.0 * t):
+            raise RuntimeError(f"no force at t = {t} s")
+        return super().force(t, r_N, v_N, body)
+
+
+def test_a_part_failing_while_an_event_is_located_fails_the_run_with_its_error():
+    ball = gmuk.PointMass("ball", mass=2.0)
+    system = gmuk.System(bodies=[ball], forces=[_FailingWeight()])
+    state = system.state(r={"ball": [0.0, 0.0, 100.0]}, v={"ball": [1.0, 0.0, 3.0]})
+    plain = system.simulate(state, (0.0, 6.0), method="RK4", step=1.0)
+    assert plain.status == "success"
+    with pytest.raises(SimulationError, match=r"no force at t = 4\.") as info:
+        system.simulate(state, (0.0, 6.0), method="RK4", step=1.0,
+                        events=[_ground(terminal=True)])  # fmt: skip
+    partial = info.value.trajectory
+    assert partial.status == "failed" and partial.t[-1] == 5.0  # the step is kept

@@ -12,8 +12,9 @@ side and continuous extension, nothing written twice):
   for methods without a continuous extension (DOPRI5, RK4): the state at ``t + h`` as that
   method computes it, to its order.
 
-Each is compiled once per machine into numba's cache, on first use, apart from the loop (a
-few seconds).
+Each is compiled once per machine into numba's cache, on first use, apart from the loop (4.6 s
+on the shared 2-core box, then 0.23 s to load in a new process: benchmarks/README.md,
+"Events in simulate").
 """
 
 from __future__ import annotations
