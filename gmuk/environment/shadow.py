@@ -32,7 +32,13 @@ from gmuk._validation import real_number, real_vector
 from gmuk.environment.ephemeris import RADIUS
 from gmuk.errors import DefinitionError, DomainError
 
-__all__ = ["margin_from_angles", "shadow_angles", "shadow_fraction", "shadow_margin"]
+__all__ = [
+    "casadi_fraction",
+    "margin_from_angles",
+    "shadow_angles",
+    "shadow_fraction",
+    "shadow_margin",
+]
 
 
 @njit(cache=True)
@@ -82,6 +88,29 @@ def fraction_at(r, s, o, R_sun, R_occ):  # type: ignore[no-untyped-def]
     if b < 0.0:
         return -1.0
     return fraction_from_angles(a, b, c)
+
+
+def casadi_fraction(r: Any, s: Any, o: Any, R_sun: float, R_occ: float) -> Any:
+    """The symbolic (CasADi) form of :func:`fraction_at` for a point r (CasADi 3×1, m), the
+    Sun at s and the occulter at o (3×1, m): the same angles and the same four cases, as
+    ``if_else`` (the point is assumed outside both bodies)."""
+    from gmuk._casadi import casadi
+
+    ca = casadi()
+    u, w = s - r, o - r
+    a = ca.asin(R_sun / ca.norm_2(u))
+    b = ca.asin(R_occ / ca.norm_2(w))
+    c = ca.atan2(ca.norm_2(ca.cross(u, w)), ca.dot(u, w))
+    x = (c * c + a * a - b * b) / (2.0 * c)
+    y = ca.sqrt(ca.fmax(a * a - x * x, 0.0))
+    area = (
+        a * a * ca.acos(ca.fmin(ca.fmax(x / a, -1.0), 1.0))
+        + b * b * ca.acos(ca.fmin(ca.fmax((c - x) / b, -1.0), 1.0))
+        - c * y
+    )
+    partial = 1.0 - area / (math.pi * a * a)
+    inner = ca.if_else(c <= a - b, 1.0 - (b * b) / (a * a), partial)
+    return ca.if_else(c >= a + b, 1.0, ca.if_else(c <= b - a, 0.0, inner))
 
 
 def margin_from_angles(a: float, b: float, c: float, kind: str) -> float:

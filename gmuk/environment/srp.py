@@ -16,6 +16,12 @@ body to the Sun:
   from the centre of mass), and so the torque ``c × F``. Self-shadowing between plates is
   not modelled.
 
+Each model's force is one numba kernel (:func:`cannonball_srp_load`,
+:func:`flat_plate_srp_load`) that the Python form calls with the Sun's position and ν at
+``epoch + t``; the compiled loop cannot call the ephemerides, so it calls the Python form.
+The symbolic (CasADi) forms, for :mod:`gmuk.optimize`, take numeric times (the shadow as
+:func:`~gmuk.environment.shadow.casadi_fraction`).
+
 References
 ----------
 Montenbruck, O. & Gill, E. (2000), *Satellite Orbits*, §3.4; Vallado, D. A. (2013),
@@ -31,12 +37,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gmuk._casadi import casadi
 from gmuk._forms import Forms
 from gmuk._numba import njit
 from gmuk._validation import FloatArray, check_sequence, real_number, real_vector
 from gmuk.environment._loads import call_load
 from gmuk.environment.ephemeris import AU, RADIUS, _body, position
-from gmuk.environment.shadow import fraction_at
+from gmuk.environment.shadow import casadi_fraction, fraction_at
 from gmuk.environment.time import Epoch
 from gmuk.errors import DefinitionError, DomainError
 from gmuk.forces.base import ForceModel, com_load
@@ -62,7 +69,6 @@ _SRP_COMPILED = (
     "which the compiled loop cannot call; the physics is one numba kernel that the Python "
     "form calls with those positions and the shadow fraction"
 )
-_SRP_SYMBOLIC = "gmuk.optimize has no CasADi form of the ERFA ephemerides or of the shadow"
 
 
 @njit(cache=True)
@@ -211,6 +217,27 @@ class _Illumination:
         return s, nu
 
 
+def _casadi_illumination(model: Any, t: Any, r_N: Any) -> tuple[Any, Any]:
+    """(s_N as CasADi DM, ν as a CasADi expression of r_N) at a numeric time t: the
+    symbolic form of :meth:`_Illumination.at` (:func:`~gmuk.environment.shadow.casadi_fraction`
+    per occulter). A DefinitionError for a symbolic t."""
+    ca = casadi()
+    if isinstance(t, (ca.SX, ca.MX)):
+        raise DefinitionError(
+            f"{model.name}: the symbolic (CasADi) form of {type(model).__name__} takes numeric "
+            "times only (the Sun and the occulters are ERFA's series at epoch + t); "
+            "gmuk.optimize then transcribes element by element with the nodes' times"
+        )
+    ill = model.illumination
+    e = ill.epoch + float(t)
+    s = ca.DM(position("sun", e, ill.centre))
+    nu = 1.0
+    for o in ill.occulters:
+        o_N = ca.DM(position(o, e, ill.centre))
+        nu = nu * casadi_fraction(r_N, s, o_N, RADIUS["sun"], RADIUS[o])
+    return s, nu
+
+
 class CannonballSRP(ForceModel):
     """Solar radiation pressure on a sphere ("cannonball"): ``f = −ν P C_R A e``.
 
@@ -240,7 +267,7 @@ class CannonballSRP(ForceModel):
     Montenbruck & Gill (2000), Eq. 3.76.
     """
 
-    _forms = Forms(compiled=_SRP_COMPILED, symbolic=_SRP_SYMBOLIC)
+    _forms = Forms(compiled=_SRP_COMPILED, symbolic=True)
 
     def __init__(
         self,
@@ -276,6 +303,22 @@ class CannonballSRP(ForceModel):
         p = self._params(t, np.asarray(r_N, dtype=float))
         return call_load(cannonball_srp_load, False, t, r_N, v_N, body, p, None, self.name)
 
+    def casadi_force(self, t: Any, r_N: Any, v_N: Any, body: Body) -> Any:
+        """The symbolic form of :meth:`force` at a numeric time t (CasADi, 3×1, N):
+        :func:`cannonball_srp_load`'s ``k (r − s)/ρ³`` with the shadow of
+        :func:`~gmuk.environment.shadow.casadi_fraction`. A DefinitionError for a symbolic t."""
+        ca = casadi()
+        s, nu = _casadi_illumination(self, t, r_N)
+        k = self.illumination.pressure * AU * AU * self.C_R * self.area
+        rho = ca.norm_2(r_N - s)
+        return (k * nu / (rho * rho * rho)) * (r_N - s)
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` (CasADi, 6×1): ``[0; Rᵀ f_N]``."""
+        ca = casadi()
+        f_N = CannonballSRP.casadi_force(self, t, g_NB[:3, 3], None, body)
+        return ca.vertcat(ca.DM.zeros(3, 1), g_NB[:3, :3].T @ f_N)
+
 
 class FlatPlateSRP(ForceModel):
     """Solar radiation pressure on a body made of flat plates: force and torque about the
@@ -300,7 +343,7 @@ class FlatPlateSRP(ForceModel):
     Montenbruck & Gill (2000), §3.4.1, Eq. 3.75; Vallado (2013), §8.6.4.
     """
 
-    _forms = Forms(compiled=_SRP_COMPILED, symbolic=_SRP_SYMBOLIC)
+    _forms = Forms(compiled=_SRP_COMPILED, symbolic=True)
 
     def __init__(
         self,
@@ -331,3 +374,27 @@ class FlatPlateSRP(ForceModel):
         k = nu * self.illumination.pressure * AU * AU
         p = (k, float(s[0]), float(s[1]), float(s[2]))
         return call_load(flat_plate_srp_load, True, t, g_NB, V_B, body, p, self._data, self.name)
+
+    def casadi_wrench(self, t: Any, g_NB: Any, V_B: Any, body: RigidBody) -> Any:
+        """The symbolic form of :meth:`wrench` at a numeric time t (CasADi, 6×1; N·m, N):
+        :func:`flat_plate_srp_load`'s sum over the lit plates (``if_else`` on n·e > 0) with
+        the shadow of :func:`~gmuk.environment.shadow.casadi_fraction`. A DefinitionError for
+        a symbolic t."""
+        ca = casadi()
+        R, r = g_NB[:3, :3], g_NB[:3, 3]
+        s, nu = _casadi_illumination(self, t, r)
+        u = s - r
+        rho = ca.norm_2(u)
+        e = R.T @ (u / rho)
+        P = nu * self.illumination.pressure * AU * AU / (rho * rho)
+        L, F = ca.DM.zeros(3, 1), ca.DM.zeros(3, 1)
+        for plate in self.plates:
+            n, c = ca.DM(plate.normal_B), ca.DM(plate.position_B)
+            cos = ca.dot(n, e)
+            f = (-P * plate.area * cos) * (
+                (1.0 - plate.specular) * e + 2.0 * (plate.specular * cos + plate.diffuse / 3.0) * n
+            )
+            f = ca.if_else(cos > 0.0, f, ca.DM.zeros(3, 1))
+            L = L + ca.cross(c, f)
+            F = F + f
+        return ca.vertcat(L, F)

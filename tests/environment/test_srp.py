@@ -152,3 +152,34 @@ def test_bad_models_are_refused():
         FlatPlateSRP(EPOCH, [])
     with pytest.raises(DefinitionError, match="Epoch"):
         CannonballSRP("2024", 1.0, 1.5)
+
+
+def test_symbolic_forms_match_in_sunlight_penumbra_and_umbra():
+    ca = pytest.importorskip("casadi")
+    s = position("sun", EPOCH)
+    s_hat = s / np.linalg.norm(s)
+    side = np.cross(s_hat, [0.0, 0.0, 1.0])
+    side /= np.linalg.norm(side)
+    ball = CannonballSRP(EPOCH, area=1.0, C_R=1.4)
+    plates = FlatPlateSRP(
+        EPOCH,
+        [
+            Plate(2.0, n, 0.3, 0.2, 0.5, [0.1, 0.4, -0.2])
+            for n in np.vstack([np.eye(3), -np.eye(3)])
+        ],
+    )
+    R = so3.exp(np.array([0.2, -0.5, 0.9]))
+    nus = []
+    for y in np.linspace(6.0e6, 6.8e6, 17):  # umbra → penumbra → sunlight, 42 000 km behind
+        r = -4.2e7 * s_hat + y * side
+        nus.append(shadow_fraction(r, s, np.zeros(3), RADIUS["earth"]))
+        f_py = ball.force(0.0, r, np.zeros(3), SAT)
+        f_ca = np.asarray(ca.DM(ball.casadi_force(0.0, ca.DM(r), None, SAT))).ravel()
+        np.testing.assert_allclose(f_ca, f_py, rtol=1e-12, atol=1e-12 * np.linalg.norm(f_py))
+        g = _pose(R, r)
+        w_py = plates.wrench(0.0, g, np.zeros(6), BODY)
+        w_ca = np.asarray(ca.DM(plates.casadi_wrench(0.0, ca.DM(g), None, BODY))).ravel()
+        np.testing.assert_allclose(w_ca, w_py, rtol=1e-12, atol=1e-12 * np.abs(w_py).max())
+    assert nus[0] == 0.0 and nus[-1] == 1.0 and any(0.0 < v < 1.0 for v in nus)
+    with pytest.raises(DefinitionError, match="numeric times only"):
+        ball.casadi_force(ca.SX.sym("t"), ca.SX.sym("r", 3), None, SAT)
