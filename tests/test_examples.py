@@ -20,6 +20,14 @@ def test_every_example_is_covered_here():
 
 
 CHECKS = {
+    # a planar loop of 3-D revolute joints: 20 rows of rank 17, taken as they are; the loop
+    # stays closed (Freudenstein's equation) while the crank falls from the top
+    "closed_loop_four_bar.py": lambda r: (
+        r["constraint_rows"] == 20
+        and r["constraint_rank"] == 17
+        and r["crank_swing_deg"] > 90.0
+        and r["freudenstein_residual_max"] < 1e-10
+    ),
     "custom_orbit_tracking.py": lambda r: (
         r["max_position_error_m"] < 1e-5 and r["max_constraint_torque_N_m"] > 0
     ),
