@@ -10,14 +10,10 @@ from gmuk.actuators.wheels import (
     ReactionWheel,
     WheelArray,
     WheelMotors,
-    wheel_array_torque,
-    wheel_spin_torque,
 )
 
 __all__ = [
     "ReactionWheel",
     "WheelArray",
     "WheelMotors",
-    "wheel_array_torque",
-    "wheel_spin_torque",
 ]

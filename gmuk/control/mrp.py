@@ -17,7 +17,7 @@ torque), and the wheel motor commands are the minimum-norm solution of ``−G u 
 
 which for three orthonormal axes is ``u_i = −g_iᵀ L`` (Basilisk ``rwMotorTorque``). Each
 wheel's motor clips its command at its torque limit and its speed limit
-(:func:`gmuk.actuators.wheel_spin_torque`). The integral ``∫ K σ dt`` is held per component
+(:func:`gmuk.actuators.wheels.wheel_spin_torque`). The integral ``∫ K σ dt`` is held per component
 within ``±integral_limit`` (it stops integrating outward at the limit; Basilisk clips the sum).
 
 Stability: with K_I = 0 and the gyroscopic term cancelled, ``V = K ln(1 + σᵀσ)·2 + ½ ωᵀ I ω``
@@ -168,8 +168,8 @@ def mrp_feedback_command(R_NB, omega, h, s_int, p, sigma, L, u_cmd):  # type: ig
 def mrp_wheel_control(t, g, V, a_model, z, p, u, z_dot):  # type: ignore[no-untyped-def]
     """The controller's wrench u = [L_w; 0] on the bus (N·m, body frame) and ż = [ḣ; K σ]
     (:data:`~gmuk.control.base.CONTROL_KERNEL`): the law's motor commands through each wheel's
-    motor (:func:`~gmuk.actuators.wheel_spin_torque`), then the wheels' torque on the bus
-    (:func:`~gmuk.actuators.wheel_array_torque`). Returns 0."""
+    motor (:func:`~gmuk.actuators.wheels.wheel_spin_torque`), then the wheels' torque on the bus
+    (:func:`~gmuk.actuators.wheels.wheel_array_torque`). Returns 0."""
     n = int(p[0])
     K, limit = p[1], p[4]
     R_NB = np.empty((3, 3))

@@ -25,7 +25,8 @@ from rw_setup import (
 )
 
 import gmuk
-from gmuk.actuators import ReactionWheel, WheelArray, WheelMotors, wheel_spin_torque
+from gmuk.actuators import ReactionWheel, WheelArray, WheelMotors
+from gmuk.actuators.wheels import wheel_array_torque, wheel_spin_torque
 from gmuk.errors import DefinitionError
 
 
@@ -100,7 +101,7 @@ def _constant_torque(form: str) -> tuple[gmuk.Trajectory, float]:
             def control(self, state, z):  # type: ignore[no-untyped-def]
                 h_dot = np.array([u])
                 L = np.empty(3)
-                gmuk.actuators.wheel_array_torque(state.twist("bus")[:3], z, w.G, h_dot, L)
+                wheel_array_torque(state.twist("bus")[:3], z, w.G, h_dot, L)
                 return [np.r_[L, 0.0, 0.0, 0.0]], h_dot
 
         ctl = Constant(["bus"], n_states=1)
