@@ -123,8 +123,9 @@ class Trajectory:
     body_dofs : tuple of int
     status : {"success", "terminated", "drifted", "interrupted", "failed"}
         "terminated": a terminal event ended the run (the last of ``events``); "drifted":
-        the run completed its span but a constraint drifted off past ``drift_tol``
-        (:func:`gmuk.engine.integrate.simulate`); the message says which and when.
+        the run completed its span (or ended at a terminal event) but a constraint drifted off
+        past ``drift_tol`` (:func:`gmuk.engine.integrate.simulate`); the message says which
+        and when.
     message : str
     stats : dict
         ``n_rhs`` (right-hand-side evaluations), ``n_steps``, ``n_rejected``, ``method``;

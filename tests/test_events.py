@@ -452,3 +452,36 @@ def test_a_part_failing_while_an_event_is_located_fails_the_run_with_its_error()
                         events=[_ground(terminal=True)])  # fmt: skip
     partial = info.value.trajectory
     assert partial.status == "failed" and partial.t[-1] == 5.0  # the step is kept
+
+
+class _OffsetWall(gmuk.HolonomicConstraint):
+    """x = 0 for a point mass with a bias off by ``error`` (m/s²): φ = ½·error·t², a drift."""
+
+    def __init__(self, body, error):
+        super().__init__([body])
+        self.error = error
+
+    def residual(self, q, t):
+        return np.array([q[0][0]])
+
+    def jacobian(self, q, t):
+        return np.array([[1.0, 0.0, 0.0]])
+
+    def bias(self, q, nu, t):
+        return np.array([self.error])
+
+    def rate(self, q, nu, t):
+        return np.array([nu[0][0]])
+
+
+def test_a_run_ended_by_its_event_off_its_constraint_is_drifted_not_terminated():
+    p = gmuk.PointMass("p", 2.0)
+    system = gmuk.System([p], [_OffsetWall(p, 1e-3)], [gmuk.UniformGravity((0, 0, -1.0))])
+    state = system.state(r={"p": [0.0, 0.0, 1.0]}, v={"p": [0.0, 1.0, 0.0]})
+    floor = Event(lambda t, s: s.position("p")[2], terminal=True, direction=-1, name="floor")
+    with pytest.warns(gmuk.errors.GmukWarning, match="drifted off"):
+        traj = system.simulate(state, (0.0, 5.0), events=[floor])
+    assert traj.status == "drifted" and not traj.success
+    assert traj.message.startswith("terminal event 'floor' at t = ")
+    assert traj.t[-1] == pytest.approx(math.sqrt(2.0), abs=1e-12)  # z = 1 − t²/2
+    assert traj.events[-1].terminal

@@ -1,5 +1,5 @@
-"""Events of a simulation: functions of (t, state) whose sign changes :func:`gmuk.simulate
-<gmuk.engine.integrate.simulate>` locates in time.
+"""Events of a simulation: functions of (t, state) whose sign changes
+:func:`~gmuk.engine.integrate.simulate` (and :meth:`gmuk.System.simulate`) locates in time.
 
 An :class:`Event` wraps a function ``g(t, state) -> float``. After every accepted step the
 loop evaluates each event at the step's end; where ``g`` changes sign over the step (in the

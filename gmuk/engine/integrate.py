@@ -312,7 +312,8 @@ def simulate(
     drift_tol : float or None
         How far a constraint may drift from where the run started it, in the units of its
         residual (default 1e-6: 1 µm, 1 µrad, 1 µm/s; see Notes). A run that completes its
-        span with a constraint past it ends with ``status="drifted"`` (so
+        span (or ends at a terminal event) with a constraint past it ends with
+        ``status="drifted"`` (so
         ``traj.success`` is False) and a GmukWarning. None measures and records the
         violations without judging them (for runs that leave their constraint by design,
         e.g. under unmodeled forces).
@@ -506,6 +507,8 @@ def check_drift(system: System, traj: Trajectory, drift_tol: float | None) -> Tr
         )
         if status == "success":
             status, message = "drifted", what
+        elif status == "terminated":  # ended by its event, but off its constraint
+            status, message = "drifted", f"{message}; {what}"
         else:
             message = f"{message}; {what}"
         warnings.warn(
