@@ -25,6 +25,7 @@ IAU SOFA Board, *SOFA Time Scale and Calendar Tools* (2021); Fairhead, L. & Bret
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import dataclass
@@ -71,6 +72,7 @@ def _dtr(jd1: float, jd2: float) -> float:
     return float(erfa.dtdb(jd1, jd2, 0.0, 0.0, 0.0, 0.0))
 
 
+@functools.total_ordering
 @dataclass(frozen=True, init=False)
 class Epoch:
     """An instant, held as a two-part Julian date in TDB.

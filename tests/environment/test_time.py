@@ -98,6 +98,7 @@ def test_iso_and_julian_dates_round_trip_in_every_scale(scale):
 def test_epochs_compare_and_subtract_in_tdb_seconds():
     a, b = Epoch("2024-01-01"), Epoch("2024-01-02")
     assert a < b and not b < a
+    assert a <= b and b >= a and b > a and not a > b
     assert b - a == pytest.approx(86400.0 + b.tdb_minus_tt() - a.tdb_minus_tt(), abs=1e-6)
     assert Epoch.from_tdb_seconds(a.tdb_seconds) - a == pytest.approx(0.0, abs=1e-6)
 
