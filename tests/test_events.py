@@ -81,8 +81,11 @@ def _kepler(e=0.3, a=7.0e6, tau0_periods=-0.3):
 
 
 def test_kepler_apsis_times_match_keplers_equation():
-    system, state, orbit, t_peri = _kepler()
+    system, state, orbit, _ = _kepler()
     period = orbit.period
+    # the reference: the start's time since periapsis by Kepler's equation (gmuk.orbits)
+    _, tau0 = KeplerOrbit.from_state(state.position("sat"), state.velocity("sat"), MU)
+    t_peri = -tau0
     events = [ApsisEvent("sat", kind="periapsis"), ApsisEvent("sat", MU, kind="apoapsis")]
     traj = system.simulate(state, (0.0, 2.6 * period), rtol=1e-13, atol=1e-13, events=events)
     assert traj.status == "success"
