@@ -437,6 +437,8 @@ RUNS: dict[str, Run] = {
         "(benchmarks/bench_optimize.py --table)", seconds=25, function=_optimize_table
     ),
     "panda": Run("panda", seconds=6),
+    "four-bar": Run("four-bar", seconds=4),
+    "stewart": Run("stewart", seconds=5),
 }
 
 
@@ -793,6 +795,24 @@ _add(
     "panda",
     ("3.1e-10 rad", "pinocchio_max_q_difference_rad", "{:.1e} rad", "within"),
     ("84.5 J", "energy_dissipated_J", "{:.1f} J", "dissipate"),
+)
+
+# docs/robotics_loops.rst -----------------------------------------------------------------------
+_add(
+    "docs/robotics_loops.rst",
+    "four-bar",
+    ("< 2e-12 m or rad", "loop_position_residual_max", "< {:.0e} m or rad", "", "below"),
+    ("stays < 1e-11", "freudenstein_residual_max", "stays < {:.0e}", "", "below"),
+    ("< 2e-12 relative", "energy_drift_rel", "< {:.0e} relative", "", "below"),
+    ("are 20,", "constraint_rows", "are {},", "constraint"),
+    ("rank 17.", "constraint_rank", "rank {}.", "constraint"),
+)
+_add(
+    "docs/robotics_loops.rst",
+    "stewart",
+    ("1.36 mm below", "platform_sag_final_m*1000", "{:.2f} mm below"),
+    ("24.23 N", "leg_force_final_mean_N", "{:.2f} N", "pushing"),
+    ("< 1e-12 m.", "loop_position_residual_max", "< {:.0e} m.", "", "below"),
 )
 
 # docs/view.rst ---------------------------------------------------------------------------------

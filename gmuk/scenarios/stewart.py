@@ -248,6 +248,7 @@ def run(
         "platform_tilt_max_rad": float(tilt.max()),
         "platform_horizontal_max_m": float(np.abs(plat.position[:, :2]).max()),
         "leg_force_final_N": [float(f) for f in force[-1]],
+        "leg_force_final_mean_N": float(force[-1].mean()),
         "loop_position_residual_max": pos,
         "loop_velocity_residual_max": vel,
         "n_rhs": int(traj.stats.get("n_rhs", 0)),
