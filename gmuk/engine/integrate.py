@@ -61,6 +61,7 @@ from gmuk.engine.integrators import _compiled, _program
 from gmuk.engine.integrators import get_method as get_method
 from gmuk.engine.integrators import method_names as method_names
 from gmuk.engine.integrators._base import label
+from gmuk.engine.integrators._dop853_tableau import INTERPOLATOR_POWER
 from gmuk.errors import DefinitionError, GmukError, GmukWarning, SimulationError
 from gmuk.lie import _kernels
 from gmuk.state import State
@@ -1061,24 +1062,24 @@ class _Loop:
         Y1 = np.empty(n)
         h = t1 - t0
         if m.dense:
-            F = np.empty((_compiled._tab.INTERPOLATOR_POWER, n))
+            F = np.empty((INTERPOLATOR_POWER, n))
             check(_event_step.dense_step(prog.parts, m, fs_x, ints_x, t0, h, Y0, G0, f0, K, Y1, F))
 
             def at(t: float) -> State:
                 u = np.empty(n)
                 _event_step.interpolate(F, Y0, (t - t0) / h, u)
-                return p.state(t, u, G0)
+                return p.adopt(t, u, G0)
 
             return at
 
         def at_stepped(t: float) -> State:
             if t == t0:
-                return p.state(t, Y0, G0)
+                return p.adopt(t, Y0, G0)
             Yt = np.empty(n)
             check(
                 _event_step.method_step(prog.parts, m, fs_x, ints_x, t0, t - t0, Y0, G0, f0, K, Yt)
             )
-            return p.state(t, Yt, G0)
+            return p.adopt(t, Yt, G0)
 
         return at_stepped
 
