@@ -200,6 +200,17 @@ COMMANDS: dict[str, tuple[str, str, list[tuple[str, str]], str]] = {
         ],
         "robotics",
     ),
+    "rw-pointing": (
+        "",
+        "none (beyond the thesis: Basilisk's reaction-wheel pointing example, issue #29)",
+        [
+            ("attitude", "Attitude σ_BN under MRP feedback, from (0.1, 0.2, −0.3) to 0."),
+            ("rates", "Body rates ω_BN (rad/s)."),
+            ("wheel_speeds", "Wheel speeds relative to the bus (rpm)."),
+            ("motor_torques", "Motor torques, at their 0.2 N·m limit early in the slew."),
+        ],
+        "tutorials/gnc_wheels",
+    ),
 }
 
 

@@ -63,6 +63,17 @@ CHECKS = {
         and r["joint_residual"] < 1e-9
         and r["success"] == 1.0
     ),
+    # the slew ends on target with the momentum kept; the two wheel forms fly the same slew;
+    # the bearing gives no torque about the spin axis
+    "t7_gnc_wheels.py": lambda r: (
+        r["final_sigma_norm"] < 1e-4
+        and r["final_omega_norm_rad_s"] < 1e-6
+        and r["momentum_rel_change"] < 1e-12
+        and r["forms_attitude_difference_rad"] < 1e-10
+        and r["forms_wheel_speed_difference_rad_s"] < 1e-8
+        and r["bearing_spin_torque_max_Nm"] < 1e-14 * r["bearing_torque_max_Nm"]
+        and r["bearing_torque_max_Nm"] > 0.01
+    ),
 }
 
 
