@@ -23,8 +23,16 @@ which the crank reaches each angle.
 
 ``gmuk run four-bar`` releases the crank at θ₂ = 0 with θ̇₂ = 8 rad/s for 3 s (DOP853,
 rtol = atol = 1e-12) and writes summary.json: the final crank angle (unwrapped), the largest
-loop-closure residual of the four joints (position and velocity), and the relative energy
-drift.
+loop-closure residual of the four joints (position and velocity), Freudenstein's residual, the
+relative energy drift, and the rows and rank of A. docs/robotics_loops.rst explains the
+redundant rows.
+
+References
+----------
+McCann (2020), Eq. (2) (the Udwadia–Kalaba solve with the pseudo-inverse) and Eq. (73) (the
+relative twist of the joints). F. Freudenstein, "Approximate synthesis of four-bar
+linkages", Trans. ASME 77 (1955) 853–861. R. L. Norton, *Design of Machinery* (5th ed.,
+McGraw-Hill 2012), §4.5 (position) and §6.7 (velocity) of the four-bar; §2.4 (Grashof).
 """
 
 from __future__ import annotations

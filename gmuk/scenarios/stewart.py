@@ -29,7 +29,14 @@ residual, the leg forces at the end.
 
 Its constrained accelerations agree with Pinocchio's ``constraintDynamics`` on the same
 mechanism built as a tree with six loop-closure constraints
-(tests/robots/test_closed_loops.py).
+(tests/robots/test_closed_loops.py; docs/robotics_loops.rst).
+
+References
+----------
+D. Stewart, "A platform with six degrees of freedom", Proc. IMechE 180 (1965) 371–386.
+J.-P. Merlet, *Parallel Robots* (2nd ed., Springer 2006), Ch. 3 (the 6-UPS inverse
+kinematics). McCann (2020), Eq. (2) and Eq. (73). J. Carpentier et al., "The Pinocchio C++
+library", IEEE/SICE SII (2019) (the cross-check's constraint dynamics).
 """
 
 from __future__ import annotations
