@@ -195,6 +195,14 @@ class ReactionWheel:
         )
         self.mass = real_number(mass, "ReactionWheel mass", positive=True)
         self.name = name
+        self._frozen = True
+
+    def __setattr__(self, key: str, value: Any) -> None:
+        if getattr(self, "_frozen", False):
+            raise AttributeError(
+                f"a ReactionWheel is immutable; build a new one instead of setting {key!r}"
+            )
+        object.__setattr__(self, key, value)
 
     def spin_torque(self, command: float, speed: float) -> float:
         """Net spin torque ḣ (N·m) for a motor ``command`` (N·m) at relative ``speed`` Ω

@@ -2,8 +2,8 @@
 
 The law
 -------
-With σ = σ_BR the attitude error as modified Rodrigues parameters (short set, |σ| ≤ 1: the
-shadow set is taken whenever |σ| would exceed 1, so the error is always the shorter rotation)
+With σ = σ_BR the attitude error as modified Rodrigues parameters (short set, ‖σ‖ ≤ 1: the
+shadow set is taken whenever ‖σ‖ would exceed 1, so the error is always the shorter rotation)
 of the body B relative to a constant reference R (``R_NR``; inertial pointing by default),
 ω = ω_BN (rad/s, body frame) and ``H = I_B ω + Σ J_s Ω_i g_i`` the spacecraft's angular
 momentum, the commanded body torque is
@@ -20,8 +20,10 @@ wheel's motor clips its command at its torque limit and its speed limit
 (:func:`gmuk.actuators.wheels.wheel_spin_torque`). The integral ``∫ K σ dt`` is held per component
 within ``±integral_limit`` (it stops integrating outward at the limit; Basilisk clips the sum).
 
-Stability: with K_I = 0 and the gyroscopic term cancelled, ``V = K ln(1 + σᵀσ)·2 + ½ ωᵀ I ω``
-gives ``V̇ = −P ωᵀω`` while the motors are not saturated (Schaub & Junkins 2018, §8.4).
+Stability: with K_I = 0 and the motors not saturated, ``G ḣ = −L`` turns Euler's equation
+``I_w ω̇ + ω × H + G ḣ = 0`` (``I_w = I_B − Σ J_s g gᵀ``) into ``I_w ω̇ = −K σ − P ω``, and
+``V = 2K ln(1 + σᵀσ) + ½ ωᵀ I_w ω`` has ``V̇ = −P ωᵀω`` (σ̇ = ¼ B(σ) ω, σᵀB = (1 + σᵀσ) σᵀ;
+Schaub & Junkins 2018, §8.4).
 
 The Controller form
 -------------------
@@ -86,7 +88,7 @@ _PER_WHEEL = 10
 
 @njit(cache=True)
 def mrp_short(R, sigma):  # type: ignore[no-untyped-def]
-    """The short-set MRPs σ (|σ| ≤ 1) of the rotation R (3, 3), written into sigma (3,):
+    """The short-set MRPs σ (‖σ‖ ≤ 1) of the rotation R (3, 3), written into sigma (3,):
     R = R_NB gives σ_BN (:func:`gmuk.attitude.mrp_from_R_NB`). Shepperd's quaternion with
     q₀ ≥ 0, then σ = q / (1 + q₀)."""
     tr = R[0, 0] + R[1, 1] + R[2, 2]

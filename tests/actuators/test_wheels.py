@@ -66,6 +66,14 @@ def test_wheel_refuses_bad_definitions(kwargs: dict, match: str) -> None:
         ReactionWheel(**kwargs)
 
 
+def test_wheel_is_immutable() -> None:
+    w = ReactionWheel([1, 0, 0], 0.1)
+    with pytest.raises(AttributeError, match="immutable"):
+        w.max_torque = 1.0
+    with pytest.raises(ValueError, match="read-only"):
+        w.axis_B[0] = 0.5
+
+
 def test_wheel_frame_has_the_spin_axis_first_and_is_a_rotation() -> None:
     rng = np.random.default_rng(3)
     for _ in range(20):
