@@ -539,6 +539,26 @@ def _mrp_feedback(rng: np.random.Generator) -> Case:
     return Case(ctl, sys, state, modeled=rng.normal(size=6))
 
 
+def _momentum_wheels(rng: np.random.Generator) -> Case:
+    from gmuk.actuators import MomentumWheels, ReactionWheel
+
+    n = int(rng.integers(1, 5))
+    wheels = [
+        ReactionWheel(_direction(rng), rng.uniform(0.01, 0.2), friction=rng.uniform(0.0, 1e-3))
+        for _ in range(n)
+    ]
+    torques = rng.normal(size=n)
+    ctl = MomentumWheels("bus", wheels, lambda t, R, w, s: torques)
+    bus = gmuk.RigidBody("bus", 750.0, _inertia(rng) * 1e3)
+    sys = gmuk.System([bus], controllers=[ctl])
+    state = sys.state(
+        g={"bus": _pose(rng, np.zeros(3))},
+        V={"bus": np.r_[0.1 * rng.normal(size=3), 0.0, 0.0, 0.0]},
+        z=rng.normal(size=n) * 5.0,
+    )
+    return Case(ctl, sys, state)
+
+
 def _wheel_motors(rng: np.random.Generator) -> Case:
     from gmuk.actuators import ReactionWheel, WheelArray, WheelMotors
 
@@ -561,7 +581,7 @@ def _baumgarte(rng: np.random.Generator) -> gmuk.Baumgarte | None:
 
 def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
     from gmuk import robots
-    from gmuk.actuators import WheelMotors
+    from gmuk.actuators import MomentumWheels, WheelMotors
     from gmuk.forces.thesis_gravity import ThesisRadialHarmonicGravity
     from gmuk.optimize.result import OpenLoopControl
     from gmuk.scenarios.unmodeled import HarmonicPerturbation
@@ -587,6 +607,7 @@ def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
         gmuk.RelativeConstraint: _relative_constraint,
         gmuk.MRPFeedback: _mrp_feedback,
         WheelMotors: _wheel_motors,
+        MomentumWheels: _momentum_wheels,
         **_environment_factories(),
         **{cls: _joint(cls) for cls in _joint_kinds()},
         robots.JointEffort: _joint_force(robots.JointEffort),

@@ -25,7 +25,7 @@ from rw_setup import (
 )
 
 import gmuk
-from gmuk.actuators import ReactionWheel, WheelArray, WheelMotors
+from gmuk.actuators import MomentumWheels, ReactionWheel, WheelArray, WheelMotors
 from gmuk.actuators.wheels import wheel_array_torque, wheel_spin_torque
 from gmuk.errors import DefinitionError
 
@@ -205,3 +205,30 @@ def test_wheel_motors_checks_its_definition() -> None:
         WheelMotors("bus", ["a", "b", "c"], w, command=3.0)
     with pytest.raises(DefinitionError, match="ReactionWheel"):
         WheelArray([])
+
+
+def test_one_command_flies_both_forms_and_momentum_wheels_is_mrp_feedback() -> None:
+    """MomentumWheels driven by MRPFeedback.wheel_command (Python, called back) flies the
+    same 60 s as MRPFeedback itself (compiled) to the integrator's tolerance: at
+    rtol = atol = 1e-14 the wheel momenta differ by 2.7e-12 N·m·s (3.8e-10 at 1e-13; the
+    step sequences differ: MRPFeedback carries three integral states more). The
+    internal-momentum physics is one definition under any command."""
+    w = wheels(friction=1e-4)
+    a = internal(w)
+    bus = gmuk.RigidBody("bus", 750.0, w.spun_down_inertia(I_B))
+    driven = MomentumWheels(bus, w, a.law.wheel_command)
+    system = gmuk.System([bus], controllers=[driven])
+    state = system.state(
+        g={"bus": a.state.pose("bus")},
+        V={"bus": a.state.twist("bus")},
+        z=driven.states(a.state.twist("bus")[:3], SPEEDS0),
+    )
+    t_eval = np.linspace(0.0, 60.0, 7)
+    ta = a.system.simulate(a.state, (0.0, 60.0), rtol=1e-14, atol=1e-14, t_eval=t_eval)
+    tb = system.simulate(state, (0.0, 60.0), rtol=1e-14, atol=1e-14, t_eval=t_eval)
+    Ra, Rb = ta.body("bus").R, tb.body("bus").R
+    angle = [np.linalg.norm(gmuk.lie.so3.log(x.T @ y)) for x, y in zip(Ra, Rb, strict=True)]
+    assert max(angle) < 1e-12
+    np.testing.assert_allclose(tb.z, ta.z[:, :3], rtol=1e-11, atol=0)
+    with pytest.raises(DefinitionError, match="callable"):
+        MomentumWheels(bus, w, None)  # type: ignore[arg-type]
