@@ -31,7 +31,8 @@ solve sees it and returns the exact internal (bearing) torques that keep the whe
 axis. Nothing in this form knows of gyroscopic coupling: it comes out of the constrained
 rigid-body equations.
 
-*Internal-momentum form* (used by :class:`gmuk.control.MRPFeedback`): the bus alone is a
+*Internal-momentum form* (:class:`gmuk.actuators.MomentumWheels` under any wheel command,
+:class:`gmuk.control.MRPFeedback` with its law compiled in): the bus alone is a
 RigidBody of inertia ``I_w`` and the wheels' momenta h are internal states of a controller;
 the wheels act on the bus through the torque
 
