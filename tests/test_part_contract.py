@@ -575,6 +575,15 @@ def _wheel_motors(rng: np.random.Generator) -> Case:
     return _case(rng, model, (bus, *bodies), (0, 10), 1.0, constraints=cons)
 
 
+def _point_plane_contact(rng: np.random.Generator) -> Case:
+    from gmuk.constraints.unilateral import PointPlaneContact
+
+    body = _bodies(rng)[0]
+    points = rng.normal(size=(int(rng.integers(1, 5)), 3))
+    c = PointPlaneContact(body, points, normal=_direction(rng), height=rng.normal())
+    return _case(rng, c, (body,), (0.0, 10.0), 1.0)
+
+
 def _baumgarte(rng: np.random.Generator) -> gmuk.Baumgarte | None:
     return None if rng.integers(0, 2) else gmuk.Baumgarte.critical(rng.uniform(0.01, 1.0))
 
@@ -582,6 +591,7 @@ def _baumgarte(rng: np.random.Generator) -> gmuk.Baumgarte | None:
 def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
     from gmuk import robots
     from gmuk.actuators import MomentumWheels, WheelMotors
+    from gmuk.constraints.unilateral import PointPlaneContact
     from gmuk.forces.thesis_gravity import ThesisRadialHarmonicGravity
     from gmuk.optimize.result import OpenLoopControl
     from gmuk.scenarios.unmodeled import HarmonicPerturbation
@@ -612,6 +622,7 @@ def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
         **{cls: _joint(cls) for cls in _joint_kinds()},
         robots.JointEffort: _joint_force(robots.JointEffort),
         robots.JointSpringDamper: _joint_force(robots.JointSpringDamper),
+        PointPlaneContact: _point_plane_contact,
     }
 
 

@@ -230,6 +230,10 @@ class System:
             cls = solvers.resolve(solver)
         elif self.tangent_bundle_method == "eq80":
             cls = solvers.TangentBundleEq80Solver
+        elif any(getattr(c, "unilateral", False) for c in self.constraints):
+            from gmuk.engine.contact import ContactSolver  # the contact solve (its own module)
+
+            cls = ContactSolver
         elif sparse is True or (sparse == "auto" and self.layout.n_dof > SPARSE_THRESHOLD):
             cls = solvers.SparseSolver
         elif not solvers.FusedRigidSolver.problems(self):
