@@ -515,7 +515,17 @@ class FixedJoint(Joint):
         return np.zeros((6, 0))
 
 
-class RevoluteJoint(Joint):
+class _AxisJoint(Joint):
+    """A joint whose motion is about or along one ``axis`` (unit, in both joint frames)."""
+
+    def __init__(
+        self, parent: Body | str | None, child: Body | str, *, axis: Any = (0, 0, 1), **kw: Any
+    ) -> None:
+        self.axis = _unit(axis, "axis")
+        super().__init__(parent, child, **kw)
+
+
+class RevoluteJoint(_AxisJoint):
     """Rotation about ``axis`` (unit, in the joint frames; default z) through their common
     origin: 5 rows; coordinate the angle (rad).
 
@@ -530,43 +540,25 @@ class RevoluteJoint(Joint):
     kind = "revolute"
     _forms = _JOINT_FORMS
 
-    def __init__(
-        self, parent: Body | str | None, child: Body | str, *, axis: Any = (0, 0, 1), **kw: Any
-    ) -> None:
-        self.axis = _unit(axis, "axis")
-        super().__init__(parent, child, **kw)
-
     def _subspace(self) -> FloatArray:
         return _axis_subspace([self.axis], [])
 
 
-class PrismaticJoint(Joint):
+class PrismaticJoint(_AxisJoint):
     """Translation along ``axis`` (default z): 5 rows; coordinate the displacement (m)."""
 
     kind = "prismatic"
     _forms = _JOINT_FORMS
 
-    def __init__(
-        self, parent: Body | str | None, child: Body | str, *, axis: Any = (0, 0, 1), **kw: Any
-    ) -> None:
-        self.axis = _unit(axis, "axis")
-        super().__init__(parent, child, **kw)
-
     def _subspace(self) -> FloatArray:
         return _axis_subspace([], [self.axis])
 
 
-class CylindricalJoint(Joint):
+class CylindricalJoint(_AxisJoint):
     """Rotation about and translation along ``axis``: 4 rows; coordinates (angle, slide)."""
 
     kind = "cylindrical"
     _forms = _JOINT_FORMS
-
-    def __init__(
-        self, parent: Body | str | None, child: Body | str, *, axis: Any = (0, 0, 1), **kw: Any
-    ) -> None:
-        self.axis = _unit(axis, "axis")
-        super().__init__(parent, child, **kw)
 
     def _subspace(self) -> FloatArray:
         return _axis_subspace([self.axis], [self.axis])
