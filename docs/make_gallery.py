@@ -211,6 +211,18 @@ COMMANDS: dict[str, tuple[str, str, list[tuple[str, str]], str]] = {
         ],
         "tutorials/gnc_wheels",
     ),
+    "quadruped": (
+        "--duration 0.3",
+        "none (beyond the thesis: robots with contacts, issue #28)",
+        [
+            (
+                "quadruped_contacts",
+                "Solo12 landing 1 mm onto four frictionless feet: base height, the feet's normal "
+                "forces (their sum the weight) and each contact's complementarity.",
+            ),
+        ],
+        "robotics",
+    ),
 }
 
 

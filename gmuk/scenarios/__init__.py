@@ -82,6 +82,7 @@ SCENARIOS: dict[str, str] = {
     "four-bar": "gmuk.scenarios.four_bar:SCENARIO",
     "stewart": "gmuk.scenarios.stewart:SCENARIO",
     "panda": "gmuk.scenarios.panda:SCENARIO",
+    "quadruped": "gmuk.scenarios.quadruped:SCENARIO",
 }
 
 #: Entry-point group through which other packages register scenarios.
