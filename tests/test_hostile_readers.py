@@ -455,7 +455,11 @@ def test_malformed_stats_are_refused(saved, tmp_path):
 def test_a_bad_status_or_message_is_refused(saved, tmp_path):
     for bad in ("ok", "Success", None, 1):
         path = _rewrite(saved, tmp_path / "status.npz", meta=lambda m, b=bad: m.update(status=b))
-        _refused(path, "status must be one of \\['success', 'drifted', 'interrupted', 'failed'\\]")
+        _refused(
+            path,
+            "status must be one of \\['success', 'terminated', 'drifted', 'interrupted', "
+            "'failed'\\]",
+        )
     path = _rewrite(saved, tmp_path / "message.npz", meta=lambda m: m.update(message=["x"]))
     _refused(path, "message must be a string")
     path = _rewrite(saved, tmp_path / "nostatus.npz", meta=lambda m: m.pop("status"))

@@ -33,7 +33,10 @@ def _visible_by_quadrature(a: float, b: float, c: float) -> float:
     lo, hi = max(-a, c - b), min(a, c + b)
     if hi <= lo:
         return 1.0
-    area, _ = quad(covered, lo, hi, epsabs=0.0, epsrel=1e-12, limit=200)
+    # the integrand has a kink where the circles cross (x = (a² − b² + c²)/2c): quad is told
+    crossing = (a * a - b * b + c * c) / (2.0 * c) if c > 0.0 else lo
+    kinks = [crossing] if lo < crossing < hi else None
+    area, _ = quad(covered, lo, hi, epsabs=0.0, epsrel=1e-12, limit=200, points=kinks)
     return 1.0 - area / (math.pi * a * a)
 
 
