@@ -584,6 +584,19 @@ def _point_plane_contact(rng: np.random.Generator) -> Case:
     return _case(rng, c, (body,), (0.0, 10.0), 1.0)
 
 
+def _joint_limit(rng: np.random.Generator) -> Case:
+    from gmuk.constraints.unilateral import JointLimit
+    from gmuk.robots import PrismaticJoint, RevoluteJoint
+
+    parent = gmuk.RigidBody("parent", rng.uniform(1.0, 10.0), _inertia(rng))
+    child = _bodies(rng)[0]
+    kind = RevoluteJoint if rng.integers(0, 2) else PrismaticJoint
+    joint = kind(parent, child, axis=_direction(rng), parent_frame=_pose(rng, np.ones(3)))
+    lower = rng.uniform(-3.0, 0.0)
+    c = JointLimit(joint, lower, lower + rng.uniform(0.1, 3.0), restitution=rng.uniform(0, 1))
+    return _case(rng, c, (parent, child), (0.0, 10.0), 1.0)
+
+
 def _baumgarte(rng: np.random.Generator) -> gmuk.Baumgarte | None:
     return None if rng.integers(0, 2) else gmuk.Baumgarte.critical(rng.uniform(0.01, 1.0))
 
@@ -591,7 +604,7 @@ def _baumgarte(rng: np.random.Generator) -> gmuk.Baumgarte | None:
 def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
     from gmuk import robots
     from gmuk.actuators import MomentumWheels, WheelMotors
-    from gmuk.constraints.unilateral import PointPlaneContact
+    from gmuk.constraints.unilateral import JointLimit, PointPlaneContact
     from gmuk.forces.thesis_gravity import ThesisRadialHarmonicGravity
     from gmuk.optimize.result import OpenLoopControl
     from gmuk.scenarios.unmodeled import HarmonicPerturbation
@@ -623,6 +636,7 @@ def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
         robots.JointEffort: _joint_force(robots.JointEffort),
         robots.JointSpringDamper: _joint_force(robots.JointSpringDamper),
         PointPlaneContact: _point_plane_contact,
+        JointLimit: _joint_limit,
     }
 
 

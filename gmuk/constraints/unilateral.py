@@ -38,7 +38,13 @@ if TYPE_CHECKING:
     from gmuk.bodies import Body
     from gmuk.state import State
 
-__all__ = ["CLOSED_GAP", "CLOSED_RATE", "PointPlaneContact", "UnilateralConstraint"]
+__all__ = [
+    "CLOSED_GAP",
+    "CLOSED_RATE",
+    "JointLimit",
+    "PointPlaneContact",
+    "UnilateralConstraint",
+]
 
 #: A gap counts as closed below this (m or rad) …
 CLOSED_GAP = 1e-9
@@ -188,3 +194,91 @@ class PointPlaneContact(UnilateralConstraint):
         u = v + np.cross(w, self.points)
         b = -(np.cross(w, u) @ m)
         return A, self._stabilised(state, b)
+
+
+class JointLimit(UnilateralConstraint):
+    """Stops on a one-coordinate joint (revolute, prismatic): ``lower ≤ q ≤ upper``.
+
+    Two gaps, ``φ₁ = q − lower`` and ``φ₂ = upper − q`` (rad or m), read with the joint's
+    :meth:`~gmuk.robots.Joint.coordinates` (angles in (−π, π], so an angular range must lie
+    within it). The joint coordinate's acceleration is linear in the bodies' ``ν̇``,
+    ``q̈ = a ν̇ + c`` with ``a = S⁺ [−Ad_{h⁻¹} Ad_{X_PJ⁻¹}, Ad_{X_CJ⁻¹}]`` and
+    ``c = S⁺ ad_{V_rel} Ad_{h⁻¹} V_{J_p}`` (:meth:`~gmuk.robots.Joint.relative_acceleration`), so
+    the rows are ``±a ν̇ ≥ ∓c − α φ̇ − β φ``.
+
+    Parameters
+    ----------
+    joint : gmuk.robots.Joint
+        A joint with one coordinate.
+    lower, upper : float
+        The stops (rad or m), lower < upper; ``-inf`` or ``inf`` for none on that side.
+    restitution, baumgarte, name
+        See :class:`UnilateralConstraint`.
+    """
+
+    body_kinds = frozenset({BodyKind.RIGID})
+    _forms = _FORMS
+
+    def __init__(
+        self,
+        joint: Any,
+        lower: float = -np.inf,
+        upper: float = np.inf,
+        *,
+        restitution: float = 0.0,
+        baumgarte: Baumgarte | None = None,
+        name: str | None = None,
+    ) -> None:
+        from gmuk.robots.joints import Joint
+
+        if not isinstance(joint, Joint) or joint.nv != 1:
+            raise DefinitionError(
+                f"a JointLimit takes a gmuk.robots joint with one coordinate; got {joint!r:.80}"
+            )
+        super().__init__(
+            list(joint.bodies),
+            restitution=restitution,
+            baumgarte=baumgarte,
+            name=name or f"{joint.name} limits",
+        )
+        lo = float(lower)
+        hi = float(upper)
+        if np.isnan(lo) or np.isnan(hi) or not lo < hi:
+            raise DefinitionError(f"a JointLimit needs lower < upper; got {lower!r}, {upper!r}")
+        self.joint, self.lower, self.upper = joint, lo, hi
+
+    def gaps(self, state: State) -> tuple[FloatArray, FloatArray]:
+        q = float(self.joint.coordinates(state)[0])
+        qd = float(self.joint.rates(state)[0])
+        return np.array([q - self.lower, self.upper - q]), np.array([qd, -qd])
+
+    def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
+        """(A (2, 6 or 12), b (2,)): ``q̈ ≥ …`` and ``−q̈ ≥ …`` on the joint's bodies."""
+        joint = self.joint
+        S_pinv = joint._S_pinv[0]
+        zero = np.zeros(6)
+        c = float(S_pinv @ joint.relative_acceleration(state, zero, zero))
+        a_C = S_pinv @ _Ad_inverse(joint.child_frame)
+        if joint.grounded:
+            a = a_C
+        else:
+            h_inv = _Ad_inverse(joint.relative_pose(state))
+            a = np.concatenate([-(S_pinv @ (h_inv @ _Ad_inverse(joint.parent_frame))), a_C])
+        A = np.vstack([a, -a])
+        b = np.array([-c, c])
+        # infinite stops give rows that never close (their gaps are infinite)
+        return A, self._stabilised_finite(state, b)
+
+    def _stabilised_finite(self, state: State, b: FloatArray) -> FloatArray:
+        g, gd = self.gaps(state)
+        g = np.where(np.isfinite(g), g, 0.0)
+        alpha = np.broadcast_to(np.asarray(self.baumgarte.alpha, dtype=float), g.shape)
+        beta = np.broadcast_to(np.asarray(self.baumgarte.beta, dtype=float), g.shape)
+        return np.asarray(b - alpha * gd - beta * g, dtype=float)
+
+
+def _Ad_inverse(g: FloatArray) -> FloatArray:
+    """Ad_{g⁻¹} (6, 6)."""
+    from gmuk.lie import se3
+
+    return np.asarray(se3._Ad(se3._inverse(g)), dtype=float)

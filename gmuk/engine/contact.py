@@ -359,7 +359,11 @@ def simulate_with_impacts(
         events: list[Event] = []
         for c in unilateral:
             shared = _Gaps(c)
-            events += [_GapEvent(shared, k, float(g0)) for k, g0 in enumerate(c.gaps(state)[0])]
+            events += [
+                _GapEvent(shared, k, float(g0))
+                for k, g0 in enumerate(c.gaps(state)[0])
+                if np.isfinite(g0)  # a stop at infinity never closes
+            ]
         seg_eval = None
         if times is not None:
             inside = times[(times >= t) & (times <= t1)]

@@ -196,3 +196,45 @@ def test_bad_contacts_say_what_is_wrong():
     state = system.state(g={"box": np.eye(4)}, V={"box": np.zeros(6)})
     with pytest.raises(DefinitionError, match="events"):
         simulate_with_impacts(system, state, (0.0, 1.0), events=[])
+
+
+def test_a_pendulum_comes_to_rest_on_its_joint_stop_with_the_static_torque():
+    """A rod on a revolute joint to the ground, gravity across it, a stop at 0.5 rad:
+    it swings onto the stop, bounces (e = 0.3) and rests there, the stop's multiplier the
+    gravity torque m g l cos θ."""
+    from gmuk.constraints.unilateral import JointLimit
+    from gmuk.lie import se3
+    from gmuk.robots import RevoluteJoint
+
+    m, l, g0 = 2.0, 0.7, 9.81
+    rod = gmuk.RigidBody("rod", m, np.diag([1e-3, m * (2 * l) ** 2 / 12, m * (2 * l) ** 2 / 12]))
+    X = np.eye(4)
+    X[:3, 3] = (l, 0.0, 0.0)
+    hinge = RevoluteJoint(None, rod, axis=(0, 0, 1), child_frame=X)
+    stop = JointLimit(hinge, lower=-0.5, upper=0.5, restitution=0.3, name="stop")
+    system = gmuk.System([rod], [hinge, stop], [gmuk.UniformGravity((0.0, -g0, 0.0))])
+    state = system.state(g={"rod": se3.inverse(X)}, V={"rod": np.zeros(6)})
+    traj = simulate_with_impacts(
+        system, state, (0.0, 3.0), t_eval=np.linspace(0.0, 3.0, 61), rtol=1e-11, atol=1e-11
+    )
+    assert traj.success, traj.message
+    q = hinge.coordinates_along(traj)[:, 0]
+    assert traj.stats["impacts"] >= 2 and q.max() <= 0.5 + 1e-9
+    assert q[-1] == pytest.approx(0.5, abs=1e-9)
+    kkt = contact_kkt(system, traj)["stop"]
+    summary = kkt.summary()
+    assert summary["penetration"] <= 1e-9 and summary["complementarity"] <= 1e-9
+    assert summary["negative_multiplier"] == 0.0
+    assert kkt.multiplier[-1, 1] == pytest.approx(m * g0 * l * math.cos(0.5), rel=1e-9)
+    assert kkt.multiplier[-1, 0] == 0.0
+
+
+def test_a_joint_limit_needs_one_coordinate_and_an_ordered_range():
+    from gmuk.constraints.unilateral import JointLimit
+    from gmuk.robots import RevoluteJoint, SphericalJoint
+
+    a, b = gmuk.RigidBody("a", 1.0, np.eye(3)), gmuk.RigidBody("b", 1.0, np.eye(3))
+    with pytest.raises(DefinitionError, match="one coordinate"):
+        JointLimit(SphericalJoint(a, b), -1.0, 1.0)
+    with pytest.raises(DefinitionError, match="lower < upper"):
+        JointLimit(RevoluteJoint(a, b), 1.0, -1.0)
