@@ -4,17 +4,17 @@ occulter positions come from the ephemerides at ``epoch + t`` and are passed in 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from gmuk._validation import FloatArray
 from gmuk.errors import DomainError
+from gmuk.forces.base import kernel_arguments
 
 if TYPE_CHECKING:
-    from gmuk.bodies import Body, RigidBody
+    from gmuk.bodies import Body
 
-_NO_INERTIA = np.zeros((3, 3))
 _NO_FIELD = np.zeros(1)
 _NO_FIELD.setflags(write=False)
 
@@ -35,18 +35,7 @@ def call_load(
     ``x`` = r_N with velocity ``v`` = v_N; arguments laid out as the compiled loop lays them
     out (:meth:`gmuk.forces.base.ForceModel._kernel_load`). A nonzero status raises a
     DomainError naming ``who``."""
-    if rigid:
-        g = np.array(x, dtype=float)
-        V = np.array(v, dtype=float)
-        J = np.array(cast("RigidBody", body).inertia, dtype=float)
-        out = np.empty(6)
-    else:
-        g = np.eye(4)
-        g[:3, 3] = x
-        V = np.zeros(6)
-        V[:3] = v
-        J = _NO_INERTIA
-        out = np.empty(3)
+    g, V, J, out = kernel_arguments(rigid, x, v, body)
     p = np.array(params, dtype=float)
     field = _NO_FIELD if data is None else data
     status = kernel(rigid, float(t), g, V, float(body.mass), J, p, field, out)

@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from gmuk.bodies import Body, RigidBody
     from gmuk.state import State
 
-__all__ = ["FORCE_KERNEL", "ForceModel", "com_load"]
+__all__ = ["FORCE_KERNEL", "ForceModel", "com_load", "kernel_arguments"]
 
 #: The signature of a force model's kernel, as the compiled loop calls it:
 #: ``(rigid, t, g (4, 4), V (6,), m, J (3, 3), p, field (read-only), out) -> status``, with
@@ -54,6 +54,25 @@ FORCE_KERNEL = numba_types.int64(
 _NO_INERTIA = np.zeros((3, 3))
 _NO_FIELD = np.zeros(1)
 _NO_FIELD.setflags(write=False)
+
+
+def kernel_arguments(
+    rigid: bool, x: Any, v: Any, body: Body
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """(g, V, J, out): a force kernel's body arguments laid out as the compiled loop lays them
+    out — a rigid body's pose ``x`` = g_NB (4, 4), twist ``v`` = V_B and central inertia, with
+    room for its wrench (6,); a point mass's position ``x`` = r_N in a pose's translation and
+    velocity ``v`` = v_N in a twist's first three entries, no inertia, room for its force (3,)."""
+    if rigid:
+        g = np.array(x, dtype=float)
+        V = np.array(v, dtype=float)
+        J = np.array(cast("RigidBody", body).inertia, dtype=float)
+        return g, V, J, np.empty(6)
+    g = np.eye(4)
+    g[:3, 3] = x
+    V = np.zeros(6)
+    V[:3] = v
+    return g, V, _NO_INERTIA, np.empty(3)
 
 
 def _read_only(data: Any) -> FloatArray:
@@ -235,18 +254,7 @@ class ForceModel(FreezesInSystem, DeclaresForms):
                 f"{body.kind} body {body.name!r}"
             )
         params, data = packed
-        if rigid:
-            g = np.array(x, dtype=float)
-            V = np.array(v, dtype=float)
-            J = np.array(cast("RigidBody", body).inertia, dtype=float)
-            out = np.empty(6)
-        else:
-            g = np.eye(4)
-            g[:3, 3] = x
-            V = np.zeros(6)
-            V[:3] = v
-            J = _NO_INERTIA
-            out = np.empty(3)
+        g, V, J, out = kernel_arguments(rigid, x, v, body)
         p = np.array(params, dtype=float)
         field = _NO_FIELD if data is None else _read_only(data)
         status = self._kernel(rigid, float(t), g, V, float(body.mass), J, p, field, out)
