@@ -281,8 +281,7 @@ class Robot:
         return robot
 
     def _build_system(self, extra: Sequence[ForceModel]) -> System:
-        forces = [*([self._weight] if self._weight is not None else []), *self._forces, *extra]
-        return System(list(self.bodies), list(self.joints.values()), forces, **self._system_options)
+        return self.with_parts(forces=extra)
 
     def with_forces(self, forces: Sequence[ForceModel]) -> Robot:
         """The same robot with more force models (on its bodies or joints) in its System."""
