@@ -31,7 +31,7 @@ from gmuk._validation import FloatArray
 from gmuk.constraints.unilateral import CLOSED_GAP, UnilateralConstraint
 from gmuk.engine.events import Event
 from gmuk.engine.solvers import DenseSolver, Solution
-from gmuk.errors import DefinitionError, SimulationError
+from gmuk.errors import ConstraintError, DefinitionError, SimulationError
 from gmuk.state import State
 from gmuk.trajectory import EventRecord, Trajectory
 
@@ -144,20 +144,30 @@ class ContactSolver(DenseSolver):
         return []
 
     def _row_ranges(self, state: State) -> list[tuple[Any, int, int]]:
-        """(constraint, first row, end row) of each constraint, rows counted at ``state``."""
-        out, r = [], 0
-        for c in self.system.constraints:
-            n = int(np.asarray(c.rows(state)[1]).reshape(-1).size)
-            out.append((c, r, r + n))
-            r += n
-        return out
+        """(constraint, first row, end row) of each constraint, rows counted once, at the first
+        state (a constraint's row count does not change along a run)."""
+        ranges: list[tuple[Any, int, int]] | None = self.__dict__.get("_ranges")
+        if ranges is None:
+            ranges, r = [], 0
+            for c in self.system.constraints:
+                n = int(np.asarray(c.rows(state)[1]).reshape(-1).size)
+                ranges.append((c, r, r + n))
+                r += n
+            self._ranges = ranges
+        return ranges
 
     def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:
         """The KKT point with the closed unilateral rows as inequalities."""
         A, b = self._rows(state, rows)
         A = np.asarray(A.toarray() if hasattr(A, "toarray") else A, dtype=float)
         equal, candidates = [], []
-        for c, r0, r1 in self._row_ranges(state):
+        ranges = self._row_ranges(state)
+        if ranges and ranges[-1][2] != b.size:
+            raise ConstraintError(
+                f"the constraints gave {b.size} rows at t = {state.t:.9g} s and "
+                f"{ranges[-1][2]} at the start: a constraint's row count may not change"
+            )
+        for c, r0, r1 in ranges:
             if isinstance(c, UnilateralConstraint):
                 closed = c.closed(state)
                 candidates += [r0 + k for k in np.flatnonzero(closed)]
