@@ -1,5 +1,5 @@
 """``gmuk run quadruped``: Solo12 landing on four exact contacts (slow: the contact solve and
-the joints' springs run in Python, about 30 ms per evaluation)."""
+the joints' springs run in Python at every evaluation)."""
 
 from __future__ import annotations
 
