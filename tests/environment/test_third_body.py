@@ -16,9 +16,9 @@ from gmuk.lie import so3
 EPOCH = Epoch("2024-03-20T03:06:00")
 
 
+@mpmath.workdps(50)  # local to the call: mpmath's precision is global to the process
 def _tidal_mp(r, d, mu) -> np.ndarray:
     """μ[(d − r)/|d − r|³ − d/|d|³] in 50-digit arithmetic (mpmath): the reference."""
-    mpmath.mp.dps = 50
     r = [mpmath.mpf(float(x)) for x in r]
     d = [mpmath.mpf(float(x)) for x in d]
     rho = [d[i] - r[i] for i in range(3)]
@@ -81,6 +81,27 @@ def _cloud(rng: np.random.Generator, n: int = 400, size: float = 5.0):
     return m, x, J
 
 
+@mpmath.workdps(40)  # local to the call: mpmath's precision is global to the process
+def _cloud_wrench_mp(m, x_B, R, r, d, mu) -> tuple[list, list]:
+    """Torque about the centre of mass and total tidal force (in N) of the point cloud,
+    summed particle by particle in 40-digit arithmetic."""
+    L_N = [mpmath.mpf(0)] * 3
+    F_N = [mpmath.mpf(0)] * 3
+    dm = [mpmath.mpf(float(v)) for v in d]
+    nd3 = mpmath.sqrt(sum(v * v for v in dm)) ** 3
+    for mi, xb in zip(m, x_B, strict=True):
+        off = R @ xb
+        p = [mpmath.mpf(float(r[k])) + mpmath.mpf(float(off[k])) for k in range(3)]
+        rho = [dm[k] - p[k] for k in range(3)]
+        n3 = mpmath.sqrt(sum(v * v for v in rho)) ** 3
+        f = [mpmath.mpf(float(mi)) * mu * (rho[k] / n3 - dm[k] / nd3) for k in range(3)]
+        o = [mpmath.mpf(float(v)) for v in off]
+        L_N = [L_N[0] + o[1] * f[2] - o[2] * f[1], L_N[1] + o[2] * f[0] - o[0] * f[2],
+               L_N[2] + o[0] * f[1] - o[1] * f[0]]  # fmt: skip
+        F_N = [F_N[k] + f[k] for k in range(3)]
+    return L_N, F_N
+
+
 def test_rigid_body_wrench_matches_point_cloud_quadrature():
     """Torque about the centre of mass and total tidal force of a point cloud, summed
     particle by particle in extended precision, against the kernel (Eq. 23 at r − d plus
@@ -99,21 +120,7 @@ def test_rigid_body_wrench_matches_point_cloud_quadrature():
     out = np.empty(6)
     third_body_load(True, 0.0, g, np.zeros(6), M, J, np.array([mu, *d]), np.zeros(1), out)
 
-    mpmath.mp.dps = 40
-    L_N = [mpmath.mpf(0)] * 3
-    F_N = [mpmath.mpf(0)] * 3
-    dm = [mpmath.mpf(float(v)) for v in d]
-    nd3 = mpmath.sqrt(sum(v * v for v in dm)) ** 3
-    for mi, xb in zip(m, x_B, strict=True):
-        off = R @ xb
-        p = [mpmath.mpf(float(r[k])) + mpmath.mpf(float(off[k])) for k in range(3)]
-        rho = [dm[k] - p[k] for k in range(3)]
-        n3 = mpmath.sqrt(sum(v * v for v in rho)) ** 3
-        f = [mpmath.mpf(float(mi)) * mu * (rho[k] / n3 - dm[k] / nd3) for k in range(3)]
-        o = [mpmath.mpf(float(v)) for v in off]
-        L_N = [L_N[0] + o[1] * f[2] - o[2] * f[1], L_N[1] + o[2] * f[0] - o[0] * f[2],
-               L_N[2] + o[0] * f[1] - o[1] * f[0]]  # fmt: skip
-        F_N = [F_N[k] + f[k] for k in range(3)]
+    L_N, F_N = _cloud_wrench_mp(m, x_B, R, r, d, mu)
     L_ref = R.T @ np.array([float(v) for v in L_N])
     F_ref = R.T @ np.array([float(v) for v in F_N])
     F_cm = R.T @ (M * tidal_acceleration(r, d, mu))

@@ -37,6 +37,7 @@ NO_JOINTS = {"quadrotor_base.urdf", "iris_simple.urdf"}
 
 
 def _random_state(model, rng):
+    pin.seed(int(rng.integers(2**31)))  # Pinocchio's own generator, seeded from the test's
     q = pin.randomConfiguration(model, -2.0 * np.ones(model.nq), 2.0 * np.ones(model.nq))
     return q, rng.normal(size=model.nv), rng.normal(size=model.nv)
 
