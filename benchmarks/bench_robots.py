@@ -51,6 +51,7 @@ def one_call(repeat: int) -> None:
         robot = Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked)
         model, data = robot.model, robot.model.createData()
         rng = np.random.default_rng(0)
+        pin.seed(0)  # Pinocchio's own generator: the same states in every run
         q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
         v, tau = rng.normal(size=model.nv), np.zeros(model.nv)
         state = robot.state(q, v)
@@ -69,6 +70,7 @@ def panda_run(repeat: int) -> None:
     robot = Robot.from_urdf(example_robot_data(path), locked_joints=locked)
     model, data = robot.model, robot.model.createData()
     rng = np.random.default_rng(12)
+    pin.seed(12)
     q0 = pin.randomConfiguration(model, -2.0 * np.ones(7), 2.0 * np.ones(7))
     v0 = rng.normal(size=7)
     t = np.linspace(0.0, 1.0, 11)
