@@ -109,7 +109,9 @@ class UnilateralConstraint(Constraint):
         return (g <= CLOSED_GAP) & (np.abs(gd) <= CLOSED_RATE)
 
     def _stabilised(self, state: State, b: FloatArray) -> FloatArray:
+        """``b − α φ̇ − β φ``; a gap at infinity (a stop not set) contributes no term."""
         g, gd = self.gaps(state)
+        g = np.where(np.isfinite(g), g, 0.0)
         alpha = np.broadcast_to(np.asarray(self.baumgarte.alpha, dtype=float), g.shape)
         beta = np.broadcast_to(np.asarray(self.baumgarte.beta, dtype=float), g.shape)
         return np.asarray(b - alpha * gd - beta * g, dtype=float)
@@ -266,15 +268,7 @@ class JointLimit(UnilateralConstraint):
             a = np.concatenate([-(S_pinv @ (h_inv @ _Ad_inverse(joint.parent_frame))), a_C])
         A = np.vstack([a, -a])
         b = np.array([-c, c])
-        # infinite stops give rows that never close (their gaps are infinite)
-        return A, self._stabilised_finite(state, b)
-
-    def _stabilised_finite(self, state: State, b: FloatArray) -> FloatArray:
-        g, gd = self.gaps(state)
-        g = np.where(np.isfinite(g), g, 0.0)
-        alpha = np.broadcast_to(np.asarray(self.baumgarte.alpha, dtype=float), g.shape)
-        beta = np.broadcast_to(np.asarray(self.baumgarte.beta, dtype=float), g.shape)
-        return np.asarray(b - alpha * gd - beta * g, dtype=float)
+        return A, self._stabilised(state, b)
 
 
 def _Ad_inverse(g: FloatArray) -> FloatArray:

@@ -189,29 +189,11 @@ class ContactSolver(DenseSolver):
         return ac, lam, rank, residual, 0.0
 
 
-def _velocity(state: State) -> FloatArray:
-    """ν (n_dof,) of a state, in the layout's order."""
-    lay = state.layout
-    nu = np.empty(lay.n_dof)
-    for name in lay.names:
-        s = lay.slot(name)
-        if s.kind == "rigid":
-            nu[s.offset : s.offset + 6] = state.V[s.index]
-        else:
-            nu[s.offset : s.offset + s.dof] = state.xdot[s.index : s.index + s.dof]
-    return nu
-
-
 def _with_velocity(state: State, nu: FloatArray) -> State:
-    """``state`` with the velocities ν."""
+    """``state`` with the generalised velocity ν (the inverse of :meth:`State.nu`)."""
     lay = state.layout
-    V, xdot = state.V.copy(), state.xdot.copy()
-    for name in lay.names:
-        s = lay.slot(name)
-        if s.kind == "rigid":
-            V[s.index] = nu[s.offset : s.offset + 6]
-        else:
-            xdot[s.index : s.index + s.dof] = nu[s.offset : s.offset + s.dof]
+    V = nu[(lay.rigid_offsets[:, None] + np.arange(6)).ravel()].reshape(state.V.shape)
+    xdot = nu[lay.euclid_offsets] if lay.n_euclid else state.xdot
     return State(state.t, state.g, V, state.x, xdot, state.z, lay)
 
 
@@ -234,7 +216,7 @@ def impulse(system: System, state: State, *, plastic: bool = False) -> tuple[Sta
         raise DefinitionError("impulse needs a System with dense rows")
     A, _ = system.constraint_rows(state)
     A = np.asarray(A.toarray() if hasattr(A, "toarray") else A, dtype=float)
-    nu = _velocity(state)
+    nu = state.nu()
     target = A @ nu
     equal, candidates, r = [], [], 0
     for c in system.constraints:

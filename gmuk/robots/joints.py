@@ -332,6 +332,9 @@ class Joint(Constraint):
         self.parent_frame = np.array(X_PJ, dtype=float)
         self.child_frame = np.array(X_CJ, dtype=float)
         self.baumgarte = baumgarte
+        # Ad_{X_PJ⁻¹}, Ad_{X_CJ⁻¹}: the joint frames' twists from the bodies' (constant)
+        self._AdP = se3._Ad(se3._inverse(self.parent_frame))
+        self._AdC = se3._Ad(se3._inverse(self.child_frame))
         S = self._subspace()
         self.motion_subspace = S
         self.nv = S.shape[1]
@@ -345,8 +348,8 @@ class Joint(Constraint):
                 [float(self.grounded), float(self._residual_kind), float(s)],
                 self.parent_frame.ravel(),
                 self.child_frame.ravel(),
-                se3._Ad(se3._inverse(self.parent_frame)).ravel(),
-                se3._Ad(se3._inverse(self.child_frame)).ravel(),
+                self._AdP.ravel(),
+                self._AdC.ravel(),
                 self._T.ravel(),
                 self._alpha,
                 self._beta,
@@ -413,29 +416,24 @@ class Joint(Constraint):
     def relative_twist(self, state: State) -> FloatArray:
         """V_rel = V_{J_c} − Ad_{h⁻¹} V_{J_p} (6,), [ω; v] in J_c (rad/s, m/s)."""
         _gP, VP, _gC, VC = self._pair(state)
-        VJc = se3._Ad(se3._inverse(self.child_frame)) @ VC
+        VJc = self._AdC @ VC
         if self.grounded:
             return VJc
-        VJp = se3._Ad(se3._inverse(self.parent_frame)) @ VP
-        return VJc - se3._Ad(se3._inverse(self.relative_pose(state))) @ VJp
+        return VJc - se3._Ad(se3._inverse(self.relative_pose(state))) @ (self._AdP @ VP)
 
     def relative_acceleration(self, state: State, Vdot_P: Any, Vdot_C: Any) -> FloatArray:
         """V̇_rel (6,), the rate of V_rel's components in J_c, from the bodies' V̇ (rad/s², m/s²).
 
         ``V̇_rel = Ad_{X_CJ⁻¹} V̇_C − Ad_{h⁻¹} Ad_{X_PJ⁻¹} V̇_P + ad_{V_rel} Ad_{h⁻¹} V_{J_p}``.
         """
-        _gP, VP, _gC, _VC = self._pair(state)
-        out = se3._Ad(se3._inverse(self.child_frame)) @ np.asarray(Vdot_C, dtype=float)
+        _gP, VP, _gC, VC = self._pair(state)
+        out = self._AdC @ np.asarray(Vdot_C, dtype=float)
         if self.grounded:
             return out
         Ad_h_inv = se3._Ad(se3._inverse(self.relative_pose(state)))
-        AdP = se3._Ad(se3._inverse(self.parent_frame))
-        W = Ad_h_inv @ (AdP @ VP)
-        return (
-            out
-            - Ad_h_inv @ (AdP @ np.asarray(Vdot_P, dtype=float))
-            + se3._ad(self.relative_twist(state)) @ W
-        )
+        W = Ad_h_inv @ (self._AdP @ VP)  # V_Jp expressed in J_c
+        V_rel = self._AdC @ VC - W
+        return out - Ad_h_inv @ (self._AdP @ np.asarray(Vdot_P, dtype=float)) + se3._ad(V_rel) @ W
 
     def rates(self, state: State) -> FloatArray:
         """Joint rates q̇ (nv,): ``S⁺ V_rel`` (rad/s, m/s)."""
@@ -477,12 +475,11 @@ class Joint(Constraint):
         ``W_P = −(Ad_{h⁻¹} Ad_{X_PJ⁻¹})ᵀ S τ`` (zero for a joint to the ground). Their power
         is ``τ · q̇``."""
         F = self._subspace_at(state) @ np.asarray(tau, dtype=float)
-        W_C = se3._Ad(se3._inverse(self.child_frame)).T @ F
+        W_C = self._AdC.T @ F
         if self.grounded:
             return np.zeros(6), W_C
         Ad_h_inv = se3._Ad(se3._inverse(self.relative_pose(state)))
-        AdP = se3._Ad(se3._inverse(self.parent_frame))
-        return -(Ad_h_inv @ AdP).T @ F, W_C
+        return -(Ad_h_inv @ self._AdP).T @ F, W_C
 
     def _subspace_at(self, state: State) -> FloatArray:
         """S at ``state`` (constant but for the universal joint)."""
