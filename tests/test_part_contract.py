@@ -559,6 +559,25 @@ def _momentum_wheels(rng: np.random.Generator) -> Case:
     return Case(ctl, sys, state)
 
 
+def _thrusters(rng: np.random.Generator) -> Case:
+    from gmuk.actuators import Thruster, Thrusters
+
+    n = int(rng.integers(1, 6))
+    thrusters = [
+        Thruster(rng.normal(size=3), _direction(rng), rng.uniform(1.0, 50.0), rng.uniform(100, 400))
+        for _ in range(n)
+    ]
+    body = gmuk.RigidBody("sc", rng.uniform(100.0, 1000.0), _inertia(rng) * 1e2)
+    ctl = Thrusters(body, thrusters, dry_mass=0.5 * body.mass)
+    sys = gmuk.System([body], controllers=[ctl])
+    state = sys.state(
+        g={"sc": _pose(rng, np.zeros(3))},
+        V={"sc": 0.1 * rng.normal(size=6)},
+        z=np.r_[body.mass * rng.uniform(0.6, 1.0), rng.uniform(0.0, 1.0, size=n)],
+    )
+    return Case(ctl, sys, state)
+
+
 def _wheel_motors(rng: np.random.Generator) -> Case:
     from gmuk.actuators import ReactionWheel, WheelArray, WheelMotors
 
@@ -603,7 +622,7 @@ def _baumgarte(rng: np.random.Generator) -> gmuk.Baumgarte | None:
 
 def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
     from gmuk import robots
-    from gmuk.actuators import MomentumWheels, WheelMotors
+    from gmuk.actuators import MomentumWheels, Thrusters, WheelMotors
     from gmuk.constraints.unilateral import JointLimit, PointPlaneContact
     from gmuk.forces.thesis_gravity import ThesisRadialHarmonicGravity
     from gmuk.optimize.result import OpenLoopControl
@@ -631,6 +650,7 @@ def _factories() -> dict[type, Callable[[np.random.Generator], Case]]:
         gmuk.MRPFeedback: _mrp_feedback,
         WheelMotors: _wheel_motors,
         MomentumWheels: _momentum_wheels,
+        Thrusters: _thrusters,
         **_environment_factories(),
         **{cls: _joint(cls) for cls in _joint_kinds()},
         robots.JointEffort: _joint_force(robots.JointEffort),

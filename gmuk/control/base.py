@@ -28,6 +28,7 @@ from gmuk.errors import DefinitionError
 
 if TYPE_CHECKING:
     from gmuk.bodies import Body
+    from gmuk.engine.system import System
     from gmuk.state import State
 
 __all__ = ["CONTROL_KERNEL", "Controller"]
@@ -88,6 +89,11 @@ class Controller(FreezesInSystem, DeclaresForms, abc.ABC):
         built-in controller returns its term only when its ``control`` is not overridden
         (:meth:`_methods_are`)."""
         return None
+
+    def _system_problems(self, system: System) -> list[str]:
+        """What this controller cannot work with in ``system`` (checked once the System's
+        parts are valid; none by default), one message each."""
+        return []
 
     def initial_state(self) -> FloatArray:
         """Initial internal state z(0), shape (n_states,); zeros unless overridden."""

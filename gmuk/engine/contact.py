@@ -29,6 +29,7 @@ import numpy as np
 
 from gmuk._validation import FloatArray
 from gmuk.constraints.unilateral import CLOSED_GAP, UnilateralConstraint
+from gmuk.engine import segments
 from gmuk.engine.events import Event
 from gmuk.engine.solvers import DenseSolver, Solution
 from gmuk.errors import ConstraintError, DefinitionError, SimulationError
@@ -283,24 +284,10 @@ class _GapEvent(Event):
 
 
 def _join(parts: Sequence[Trajectory], impacts: list[EventRecord]) -> Trajectory:
-    """One trajectory of consecutive segments (time-major fields concatenated)."""
-    first, last = parts[0], parts[-1]
-    fields: dict[str, Any] = {}
-    for f in dataclasses.fields(Trajectory):
-        value = getattr(first, f.name)
-        if isinstance(value, np.ndarray) and value.shape[:1] == first.t.shape[:1]:
-            fields[f.name] = np.concatenate([getattr(p, f.name) for p in parts])
-    stats = dict(last.stats)
-    for key in ("n_rhs", "n_steps", "n_rejected"):
-        if all(key in p.stats for p in parts):
-            stats[key] = sum(int(p.stats[key]) for p in parts)
-    stats["impacts"] = len(impacts)
-    return dataclasses.replace(
-        last,
-        **fields,
-        stats=stats,
-        events=tuple(e for p in parts for e in p.events if e not in impacts) + tuple(impacts),
-    )
+    """One trajectory of consecutive segments, with the impacts counted and last in its
+    events."""
+    events = tuple(e for p in parts for e in p.events if e not in impacts) + tuple(impacts)
+    return segments.join(parts, stats={"impacts": len(impacts)}, events=events)
 
 
 def simulate_with_impacts(
@@ -356,19 +343,16 @@ def simulate_with_impacts(
                 for k, g0 in enumerate(c.gaps(state)[0])
                 if np.isfinite(g0)  # a stop at infinity never closes
             ]
-        seg_eval = None
-        if times is not None:
-            inside = times[(times >= t) & (times <= t1)]
-            seg_eval = inside if inside.size and inside[-1] == t1 else np.append(inside, t1)
+        seg_eval = segments.segment_times(times, t, t1, first=True)
         traj = system.simulate(state, (t, t1), t_eval=seg_eval, events=events, **options)
         if traj.status != "terminated":
-            parts.append(_trimmed(traj, times, drop_last=False))
+            parts.append(segments.trimmed(traj, times, drop_last=False))
             break
         hit = traj.events[-1]
         state, _ = impulse(system, hit.state, plastic=_slow(hit.state, unilateral, rest_speed))
         state = project(system, state)
         impacts.append(hit)
-        parts.append(_trimmed(traj, times, drop_last=True))
+        parts.append(segments.trimmed(traj, times, drop_last=True))
         if len(impacts) > max_impacts:
             raise SimulationError(f"more than {max_impacts} impacts by t = {hit.t:.9g} s")
         t = hit.t
@@ -376,24 +360,6 @@ def simulate_with_impacts(
 
     joined = _join([p for p in parts if len(p)] or parts[-1:], impacts)
     return check_drift(system, joined, options.get("drift_tol", 1e-6))
-
-
-def _trimmed(traj: Trajectory, times: FloatArray | None, drop_last: bool) -> Trajectory:
-    """The outputs of one segment to keep: without the impact state (the next segment
-    starts from the state after it), and only the requested times when ``t_eval`` was
-    given."""
-    n = len(traj)
-    keep = np.ones(n, dtype=bool)
-    if drop_last and n:
-        keep[-1] = False
-    if times is not None:
-        keep &= np.isin(traj.t, times)
-    fields: dict[str, Any] = {}
-    for f in dataclasses.fields(Trajectory):
-        value = getattr(traj, f.name)
-        if isinstance(value, np.ndarray) and value.shape[:1] == (n,):
-            fields[f.name] = value[keep]
-    return dataclasses.replace(traj, **fields)
 
 
 def project(system: System, state: State) -> State:

@@ -169,6 +169,8 @@ class System:
         self.forces = tuple(forces)
         self.controllers = tuple(controllers)
         problems = self._validate()
+        if not problems:  # what a controller asks of the rest of the System
+            problems = [p for ctl in self.controllers for p in ctl._system_problems(self)]
         if problems:
             raise DefinitionError(problems)
         if sparse not in ("auto", True, False):

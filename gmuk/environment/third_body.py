@@ -151,6 +151,8 @@ class ThirdBodyPerturbation(ForceModel):
     Battin (1999), §8.4; McCann (2020), Eqs. (23a)–(23b); Montenbruck & Gill (2000), §3.3.
     """
 
+    mass_proportional = True  # gravity: force ∝ m, torque ∝ J
+
     _forms = Forms(
         compiled=(
             "the perturber's position comes from ERFA's ephemeris series at epoch + t, which "

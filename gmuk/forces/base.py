@@ -125,9 +125,17 @@ class ForceModel(FreezesInSystem, DeclaresForms):
     acts_on : frozenset of BodyKind
         Class attribute: the kinds of body this model can act on. Derived from the
         methods a subclass implements unless the subclass sets it.
+    mass_proportional : bool
+        Class attribute: whether its force and torque scale with the body's mass and
+        inertia (the gravity models: True; default False).
     """
 
     acts_on: ClassVar[frozenset[BodyKind]] = frozenset()
+    #: Whether its force and torque on a body scale with the body's mass and inertia
+    #: (gravity), so that the acceleration they give does not change when the body's mass
+    #: distribution scales: what a thrusting body of varying mass
+    #: (:class:`gmuk.actuators.Thrusters`) accepts. False unless a model says so.
+    mass_proportional: ClassVar[bool] = False
     _numeric_methods = ("wrench", "force", "wrenches")
     #: A built-in model's compiled kernel (see the module docstring); none by default.
     _kernel: ClassVar[Any]

@@ -81,6 +81,8 @@ class PointMassGravity(ForceModel):
     modeled : bool
     """
 
+    mass_proportional = True  # gravity: force ∝ m, torque ∝ J
+
     _kernel = staticmethod(point_mass_load)
     _forms = Forms(compiled=True, symbolic=True)
 
@@ -175,6 +177,8 @@ class GravityGradient(ForceModel):
     McCann (2020), Eqs. (23a)–(23b); Schaub & Junkins, *Analytical Mechanics of Space
     Systems* (2018), §4.4.
     """
+
+    mass_proportional = True  # gravity: force ∝ m, torque ∝ J
 
     _kernel = staticmethod(gravity_gradient_load)
     _forms = Forms(compiled=True, symbolic=True)
@@ -352,6 +356,8 @@ class SphericalHarmonicGravity(ForceModel):
     acceleration (the numeric :meth:`wrench` takes the latter by central differences; the two
     differ by far less than the round-off of the total force).
     """
+
+    mass_proportional = True  # gravity: force ∝ m, torque ∝ J
 
     _kernel = staticmethod(harmonic_point_load)
     _forms = Forms(compiled=True, symbolic=True)

@@ -142,6 +142,8 @@ class UniformGravity(ForceModel):
     bodies : sequence, optional
     """
 
+    mass_proportional = True  # gravity: force ∝ m, torque ∝ J
+
     _kernel = staticmethod(uniform_load)
     _forms = Forms(compiled=True, symbolic=True)
 

@@ -170,6 +170,8 @@ class ThesisRadialHarmonicGravity(ForceModel):
     McCann (2020), Eqs. (23), (25)–(28), (33), (40)–(42), (52), (58)–(59), (60)–(62).
     """
 
+    mass_proportional = True  # gravity: force ∝ m, torque ∝ J
+
     _forms = Forms(
         compiled="kept in Python: a printed approximation for reproducing Chapter 3, called "
         "back from the compiled loop",

@@ -80,6 +80,8 @@ class ThirdBodyGravity(ForceModel):
         Whether the constraint solve knows it (default True).
     """
 
+    mass_proportional = True  # gravity: force ∝ m, torque ∝ J
+
     def __init__(
         self,
         mu: float,
