@@ -211,6 +211,22 @@ COMMANDS: dict[str, tuple[str, str, list[tuple[str, str]], str]] = {
         ],
         "tutorials/gnc_wheels",
     ),
+    "lunar-flyby": (
+        "--degree 150",
+        "none (beyond the thesis: a hyperbolic lunar flyby stopped at periapsis, issue #29)",
+        [
+            (
+                "altitude",
+                "Altitude from 8262 km down to periapsis, where a terminal event stops the run.",
+            ),
+            ("speed", "Speed against the Kepler conic's."),
+            (
+                "kepler_difference",
+                "Position minus the Kepler conic's: the GRAIL field to degree 150.",
+            ),
+        ],
+        "scenarios/lunar_flyby",
+    ),
     "quadruped": (
         "--duration 0.3",
         "none (beyond the thesis: robots with contacts, issue #28)",

@@ -2380,3 +2380,43 @@ TIMINGS += [
     (LUN, "8.0 s with it", "2026-11-28, rigid body, finite-size force, --timings"),
     (LUN, "about 10 s", "2026-11-28, python examples/optimal_lunar_correction.py"),
 ]
+
+# docs/scenarios/lunar_flyby.rst ---------------------------------------------------------------
+FLY = "docs/scenarios/lunar_flyby.rst"
+RUNS["lunar-flyby"] = Run("lunar-flyby", seconds=1)
+RUNS["lunar-flyby-150"] = Run("lunar-flyby", {"degree": "150"}, seconds=2)
+_add(
+    FLY,
+    "lunar-flyby",
+    ("a = −4902.80 km", "semi_major_axis_m*0.001", "a = {:.2f} km"),
+    ("e = 1.374888", "eccentricity", "e = {:.6f}", "Measured"),
+    ("ν₀ = −114.195°", "start_true_anomaly_deg", "ν₀ = {:.3f}°"),
+    ("6275.6046 s after", "kepler_periapsis_time_s", "{:.4f} s after"),
+    ("2516.928 m/s", "kepler_periapsis_speed_m_s", "{:.3f} m/s"),
+    ("takes 41 steps", "n_steps", "takes {} steps"),
+    ("- 1.3e-10", "periapsis_time_diff_s", "- {:.1e}", "   * - time (s)"),
+    ("- −2.3e-8", "periapsis_radius_diff_m", "- {:.1e}", "   * - radius (m)"),
+    ("- 1.2e-10", "periapsis_speed_diff_m_s", "- {:.1e}", "   * - speed (m/s)"),
+    ("- 1.2e-6", "max_position_diff_m", "- {:.1e}", "   * - largest distance"),
+    ("- 1.3e-12", "energy_rel_change", "- {:.1e}", "   * - energy change"),
+    ("is < 1e-12 m/s", "periapsis_radial_speed_m_s", "is < {:.0e} m/s", "", "below"),
+)
+_add(
+    FLY,
+    "lunar-flyby-150",
+    ("- 0.01620", "periapsis_time_diff_s", "- {:.5f}", "   * - time (s)"),
+    ("- −23.31", "periapsis_radius_diff_m", "- {:.2f}", "   * - radius (m)"),
+    ("- 0.1566", "periapsis_speed_diff_m_s", "- {:.4f}", "   * - speed (m/s)"),
+    ("- 112.9", "max_position_diff_m", "- {:.1f}", "   * - largest distance"),
+    ("- 7.2e-4", "energy_rel_change", "- {:.1e}", "   * - energy change"),
+    ("periapsis 23.31 m lower", "periapsis_radius_diff_m*-1", "periapsis {:.2f} m lower"),
+)
+ALLOWED += [
+    (FLY, "--periapsis-altitude 50e3 --start-radius 2e7", "an example command's inputs"),
+    (FLY, "μ = 4.902799806931690e12 m³/s²", "GRGM660PRIM's GM, an input"),
+    (FLY, "R = 1738 km", "GRGM660PRIM's reference radius, an input"),
+    (FLY, "is 30°", _INPUT),
+    (FLY, "rtol = atol = 1e-13", _INPUT),
+    (FLY, "v∞ = 1 km/s, h_p = 100 km, r₀ = 10 000 km", "the default options, inputs"),
+    (FLY, "well under 1e-12 s", _THRESHOLD + " (issue #29's event accuracy)"),
+]
