@@ -49,10 +49,16 @@ the spacecraft's mass distribution scales uniformly, ``M(t) = μ M₀`` with
 * the thrust's acceleration is ``M(t)⁻¹ W = M₀⁻¹ (W / μ)``: :class:`Thrusters` applies
   ``W m₀ / m``.
 
+* a force not proportional to the mass (solar radiation pressure, drag, a user's wrench)
+  should give ``M(t)⁻¹ Q = M₀⁻¹ (Q / μ)``: :class:`Thrusters` adds ``(1/μ − 1) Q`` for each
+  such model named in its ``scaled_forces``. That correction acts after the solve, so it is
+  exact on a body that no constraint touches.
+
 So the run is the variable-mass motion exactly, under the stated model, and the System
-refuses what would make it inexact: a force model on the thrusting body that is not
-proportional to its mass (SRP, drag, a user's wrench: ``ForceModel.mass_proportional`` is
-False), a constraint tying it to another body, or a second controller on it. The mass
+refuses what would make it inexact: a force model on the thrusting body that is neither
+proportional to its mass (``ForceModel.mass_proportional``) nor named in ``scaled_forces``,
+scaled forces on a constrained body, a constraint tying the body to another, or a second
+controller on it. The mass
 m(t) is the controller's first internal state, ``ṁ = −Σ_open F_max,i / (I_sp,i g₀)``.
 Neglected, as in most attitude and orbit simulations: the jet-damping and relative-flow
 terms of the variable-mass equations (the momentum the propellant carries inside the
@@ -78,11 +84,12 @@ import numpy as np
 import scipy.optimize
 
 from gmuk._forms import Forms
-from gmuk._validation import FloatArray, real_number, real_vector
+from gmuk._validation import FloatArray, check_sequence, real_number, real_vector
 from gmuk.actuators.wheels import AXIS_TOL
 from gmuk.bodies import BodyKind, RigidBody
 from gmuk.control.base import Controller
 from gmuk.errors import DefinitionError, ShapeError, SimulationError
+from gmuk.forces.base import ForceModel
 
 if TYPE_CHECKING:
     from gmuk.engine.system import System
@@ -416,7 +423,18 @@ class Thrusters(Controller):
     dry_mass : float, optional
         The mass with empty tanks (kg, 0 ≤ dry_mass ≤ m₀; default 0):
         :func:`simulate_pulsed` cuts the on-times so that the mass never goes below it.
+    scaled_forces : sequence of ForceModel, optional
+        Force models of the System acting on the body that are not proportional to its mass
+        (solar radiation pressure, drag, a user's wrench), whose acceleration this
+        controller rescales to the current mass by adding ``(m₀/m − 1) Q`` for each model's
+        wrench Q: exact on a body that no constraint touches (the solve would not see the
+        correction), which the System then checks.
     name : str, optional
+
+    Notes
+    -----
+    ``traj.control_force`` holds the wrench this controller adds: the thrust over μ = m/m₀
+    plus the scaled forces' corrections.
     """
 
     body_kinds = frozenset({BodyKind.RIGID})
@@ -431,6 +449,7 @@ class Thrusters(Controller):
         thrusters: ThrusterSet | Sequence[Thruster],
         *,
         dry_mass: float = 0.0,
+        scaled_forces: Sequence[ForceModel] = (),
         name: str | None = None,
     ) -> None:
         if not isinstance(body, RigidBody):
@@ -444,7 +463,14 @@ class Thrusters(Controller):
             raise DefinitionError(
                 f"Thrusters dry_mass {dry!r} kg exceeds the body's mass {body.mass!r} kg"
             )
+        scaled = tuple(check_sequence(scaled_forces, "Thrusters scaled_forces"))
+        if not all(isinstance(f, ForceModel) for f in scaled):
+            raise DefinitionError(
+                "Thrusters scaled_forces must be gmuk.ForceModel instances; got "
+                f"{[type(f).__name__ for f in scaled]}"
+            )
         super().__init__([body], n_states=1 + len(thrusters), name=name)
+        self.scaled_forces = scaled
         self.thrusters = thrusters
         self.dry_mass = dry
         self.initial_mass = body.mass
@@ -468,7 +494,12 @@ class Thrusters(Controller):
         f = valves * self.thrusters.max_thrust
         z_dot = np.zeros(len(z))
         z_dot[0] = self.thrusters.mass_rate(f)
-        return [(self.initial_mass / m) * (self.thrusters.B @ f)], z_dot
+        ratio = self.initial_mass / m
+        u = ratio * (self.thrusters.B @ f)
+        (body,) = self.bodies
+        for model in self.scaled_forces:  # M(t)⁻¹ Q = M₀⁻¹ (Q + (m₀/m − 1) Q)
+            u = u + (ratio - 1.0) * np.asarray(model.wrenches(state, [body])[0], dtype=float)
+        return [u], z_dot
 
     def _system_problems(self, system: System) -> list[str]:
         """What in ``system`` would make the uniform-scaling mass model inexact."""
@@ -481,17 +512,30 @@ class Thrusters(Controller):
                 if f.bodies is None
                 else any((b if isinstance(b, str) else b.name) == name for b in f.bodies)
             )
-            if on_it and not f.mass_proportional:
+            scaled = any(f is g for g in self.scaled_forces)
+            if on_it and not f.mass_proportional and not scaled:
                 problems.append(
                     f"{self.name}: force model {f.name!r} ({type(f).__name__}) acts on "
                     f"{name!r} and is not proportional to its mass; with the mass varying "
-                    "(Thrusters) its acceleration would be wrong by m₀/m. Only "
-                    "mass-proportional models (ForceModel.mass_proportional) may act on a "
-                    "thrusting body"
+                    "(Thrusters) its acceleration would be wrong by m₀/m. Name it in "
+                    "Thrusters(scaled_forces=...) to rescale it (an unconstrained body), or "
+                    "act on the body with mass-proportional models only "
+                    "(ForceModel.mass_proportional)"
+                )
+        for g in self.scaled_forces:
+            if not any(g is f for f in system.forces):
+                problems.append(
+                    f"{self.name}: scaled force {g.name!r} is not one of the System's forces"
                 )
         for c in system.constraints:
             names = {b if isinstance(b, str) else b.name for b in c.bodies}
-            if name in names and len(names) > 1:
+            if name in names and self.scaled_forces:
+                problems.append(
+                    f"{self.name}: constraint {c.name!r} acts on {name!r}, whose "
+                    "scaled_forces are rescaled after the constraint solve; with scaled "
+                    "forces the thrusting body must be unconstrained"
+                )
+            elif name in names and len(names) > 1:
                 problems.append(
                     f"{self.name}: constraint {c.name!r} ties {name!r} to "
                     f"{sorted(names - {name})}; with its mass varying (Thrusters) the "

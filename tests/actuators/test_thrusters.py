@@ -25,6 +25,7 @@ from gmuk.actuators import (
     simulate_pulsed,
 )
 from gmuk.attitude import R_NB_from_mrp, mrp_from_R_NB
+from gmuk.constraints.unilateral import PointPlaneContact
 from gmuk.errors import DefinitionError, ShapeError
 
 INERTIA = np.diag([300.0, 250.0, 200.0])
@@ -226,6 +227,35 @@ def test_a_force_not_proportional_to_mass_on_the_thrusting_body_is_refused(force
         force = env.CannonballSRP(env.Epoch.from_iso("2026-11-29T00:00:00"), 2.0, 1.3)
     with pytest.raises(DefinitionError, match="not proportional to its mass"):
         _spacecraft(couple_thrusters(1.0, 10.0, 220.0), forces=(force,))
+
+
+def test_a_scaled_force_acts_on_the_current_mass() -> None:
+    # A constant body-frame push (SRP-like, not ∝ m) beside a burn along the same axis:
+    # v = (F + F_e) / k · ln(m₀ / m) with k = F / (I_sp g₀), the rocket equation's form.
+    F, F_e, isp = 400.0, 30.0, 310.0
+    body = gmuk.RigidBody("sc", MASS, INERTIA)
+    push = gmuk.AppliedWrench("sc", np.r_[0, 0, 0, F_e, 0, 0])
+    ctl = Thrusters(body, [Thruster([0, 0, 0], [1, 0, 0], F, isp)], scaled_forces=[push])
+    system = gmuk.System([body], forces=[push], controllers=[ctl])
+    state = _at_rest(system).replace(z=np.r_[MASS, 1.0])
+    traj = system.simulate(state, (0.0, 200.0), rtol=1e-12, atol=1e-12)
+    k = F / (isp * G0)
+    expected = (F + F_e) / k * np.log(MASS / (MASS - k * traj.t))
+    np.testing.assert_allclose(traj.V_B[:, 0, 3], expected, rtol=1e-10, atol=1e-12)
+
+
+def test_scaled_forces_must_be_the_systems_and_the_body_unconstrained() -> None:
+    body = gmuk.RigidBody("sc", MASS, INERTIA)
+    push = gmuk.AppliedWrench("sc", np.r_[0, 0, 0, 1.0, 0, 0])
+    ctl = Thrusters(body, couple_thrusters(1.0, 10.0, 220.0), scaled_forces=[push])
+    with pytest.raises(DefinitionError, match="not one of the System's forces"):
+        gmuk.System([body], controllers=[ctl])
+    ctl = Thrusters(body, couple_thrusters(1.0, 10.0, 220.0), scaled_forces=[push])
+    floor = PointPlaneContact(body, [[0.0, 0.0, -1.0]], normal=[0, 0, 1], height=-10.0)
+    with pytest.raises(DefinitionError, match="must be unconstrained"):
+        gmuk.System([body], constraints=[floor], forces=[push], controllers=[ctl])
+    with pytest.raises(DefinitionError, match="ForceModel"):
+        Thrusters(body, couple_thrusters(1.0, 10.0, 220.0), scaled_forces=["srp"])  # type: ignore[list-item]
 
 
 def test_gravity_on_the_thrusting_body_is_accepted() -> None:
