@@ -3,8 +3,12 @@
 :func:`view_html` draws, with plotly, the central body as a sphere (when its radius is
 given), each body's path in the inertial frame N, and an animation (play button and time
 slider) of each rigid body's axes triad, the columns of R_NB, moving along its path; point
-masses are drawn as markers. :func:`write_view` writes the HTML to a file; ``gmuk view`` and
-``gmuk run`` (``view.html`` beside the figures) call it.
+masses are drawn as markers. A system with joints (:mod:`gmuk.robots`) is drawn as its
+kinematic skeleton too: each link a thick line from its body's centre to its joint frames'
+origins, and each joint frame's triad (see :func:`view_html`'s notes); a trajectory carries
+its joints to the view in its stats (:func:`with_joint_frames`, which the robot scenarios
+call), so that ``gmuk run`` and ``gmuk view`` draw them. :func:`write_view` writes the HTML to
+a file; ``gmuk view`` and ``gmuk run`` (``view.html`` beside the figures) call it.
 
 Why plotly and not meshcat
 --------------------------
@@ -33,17 +37,32 @@ from __future__ import annotations
 import json
 import os
 import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from urllib.parse import quote
 
 import numpy as np
 
-from gmuk._validation import FloatArray, real_number, strict_integer
-from gmuk.errors import DefinitionError
+from gmuk._validation import FloatArray, check_se3, real_number, strict_integer
+from gmuk.errors import DefinitionError, GmukError
 from gmuk.trajectory import Trajectory, write_text_atomic
 
-__all__ = ["decimate", "plotly_js_name", "view_html", "write_plotly_js", "write_view"]
+if TYPE_CHECKING:
+    from gmuk.constraints.base import Constraint
+    from gmuk.engine.system import System
+
+__all__ = [
+    "JOINT_FRAMES_KEY",
+    "decimate",
+    "joint_frames",
+    "plotly_js_name",
+    "view_html",
+    "with_joint_frames",
+    "write_plotly_js",
+    "write_view",
+]
 
 #: Colours of body axes 1, 2, 3 (red, green, blue, as in most 3-D tools).
 AXIS_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
@@ -51,6 +70,12 @@ AXIS_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
 SPHERE_COLOUR = "#9a9a9a"
 #: A scene wider than this (m) is drawn in km.
 KM_ABOVE_M = 1.0e5
+#: Colour of the links of a system with joints, and of the ground's.
+LINK_COLOUR = "#5a82be"
+GROUND_COLOUR = "#505050"
+#: The key of :attr:`Trajectory.stats <gmuk.Trajectory.stats>` under which
+#: :func:`with_joint_frames` stores the joints a view draws (saved with the trajectory).
+JOINT_FRAMES_KEY = "joint_frames"
 
 
 def decimate(n: int, most: int) -> np.ndarray:
@@ -107,6 +132,136 @@ def _segments(starts: FloatArray, ends: FloatArray) -> tuple[list[Any], list[Any
     return xs, ys, zs
 
 
+# --- joints: the links and the joint frames ------------------------------------------------------
+
+
+def joint_frames(parts: System | Sequence[Constraint]) -> list[dict[str, Any]]:
+    """The joints a view draws: each :class:`gmuk.robots.Joint` among the constraints of a
+    System (or among a sequence of constraints), as a record of plain numbers and names.
+
+    Parameters
+    ----------
+    parts : System or sequence of Constraint
+        Constraints that are not joints are left out.
+
+    Returns
+    -------
+    list of dict
+        One per joint, in the constraints' order: ``name``; ``kind`` (the joint's class);
+        ``parent``, the parent body's name (None for the ground, the inertial frame N);
+        ``child``, the child's; ``X_PJ``, the pose of the joint frame J_p in the parent's
+        body frame (in N for the ground), and ``X_CJ``, the pose of J_c in the child's body
+        frame (4 × 4 nested lists, translations in m). JSON holds them exactly.
+
+    Raises
+    ------
+    DefinitionError
+        ``parts`` is neither a System nor a sequence.
+    """
+    from gmuk.engine.system import System
+    from gmuk.robots.joints import Joint
+
+    if isinstance(parts, System):
+        constraints: Sequence[Any] = parts.constraints
+    elif isinstance(parts, Sequence) and not isinstance(parts, (str, bytes)):
+        constraints = parts
+    else:
+        raise DefinitionError(
+            f"joints must be a System or a sequence of constraints; got {parts!r:.80}"
+        )
+    return [
+        {
+            "name": c.name,
+            "kind": type(c).__name__,
+            "parent": None if c.grounded else c.body_names[0],
+            "child": c.body_names[-1],
+            "X_PJ": c.parent_frame.tolist(),
+            "X_CJ": c.child_frame.tolist(),
+        }
+        for c in constraints
+        if isinstance(c, Joint)
+    ]
+
+
+def with_joint_frames(traj: Trajectory, parts: System | Sequence[Constraint]) -> Trajectory:
+    """``traj`` with :func:`joint_frames` of ``parts`` in its stats (key
+    :data:`JOINT_FRAMES_KEY`): its views draw the links and joint frames, also once saved and
+    loaded again (``gmuk view RUN_DIR``). The arrays are shared, not copied."""
+    return replace(traj, stats={**traj.stats, JOINT_FRAMES_KEY: joint_frames(parts)})
+
+
+@dataclass(frozen=True)
+class _JointFrames:
+    """A joint as a view draws it: the bodies it joins (None: the ground) and its frames."""
+
+    name: str
+    parent: str | None
+    child: str
+    X_PJ: FloatArray
+    X_CJ: FloatArray
+
+
+def _joints(traj: Trajectory, joints: System | Sequence[Constraint] | None) -> list[_JointFrames]:
+    """The joints to draw: those of ``joints``, or (None) the records in ``traj.stats``,
+    checked against the trajectory's rigid bodies."""
+    if joints is None:
+        records = traj.stats.get(JOINT_FRAMES_KEY)
+        if records is None:
+            return []
+        source = f"the trajectory's stats[{JOINT_FRAMES_KEY!r}]"
+    else:
+        records, source = joint_frames(joints), "joints"
+    keys = "name, parent, child, X_PJ, X_CJ"
+    if not isinstance(records, list):
+        raise DefinitionError(f"{source} must be a list of joint records; got {records!r:.80}")
+    rigid = [n for n, k in zip(traj.body_names, traj.body_kinds, strict=True) if k == "rigid"]
+    out = []
+    for k, rec in enumerate(records):
+        try:
+            name, parent, child = str(rec["name"]), rec["parent"], rec["child"]
+            X_PJ = check_se3(rec["X_PJ"], f"{source}[{k}]['X_PJ']")
+            X_CJ = check_se3(rec["X_CJ"], f"{source}[{k}]['X_CJ']")
+        except (KeyError, TypeError, ValueError, GmukError) as exc:
+            raise DefinitionError(
+                f"{source}[{k}] must be a joint record ({keys}: joint_frames makes them); {exc}"
+            ) from None
+        for label, body in (("parent", parent), ("child", child)):
+            if (body is not None or label == "child") and body not in rigid:
+                raise DefinitionError(
+                    f"{source}[{k}] (joint {name!r}): its {label} {body!r} is not a rigid body "
+                    f"of the trajectory (rigid bodies: {rigid})"
+                )
+        out.append(_JointFrames(name, parent, child, np.array(X_PJ), np.array(X_CJ)))
+    return out
+
+
+def _poses(traj: Trajectory, name: str, idx: np.ndarray) -> FloatArray:
+    """g_NB (k, 4, 4) of rigid body ``name`` at outputs ``idx``."""
+    view = traj.body(name)
+    g = np.zeros((len(idx), 4, 4))
+    g[:, :3, :3], g[:, :3, 3], g[:, 3, 3] = view.R[idx], view.position[idx], 1.0
+    return g
+
+
+def _joint_poses(
+    traj: Trajectory, joints: Sequence[_JointFrames], idx: np.ndarray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """At outputs ``idx``: the joint frames' poses ``g_NJp = g_NP X_PJ`` (``X_PJ`` for a joint
+    to the ground) and ``g_NJc = g_NC X_CJ``, (k, n_joints, 4, 4); and the positions r_N (m)
+    of the parents' and children's centres (body-frame origins), (k, n_joints, 3), N's
+    origin for the ground."""
+    names = {j.child for j in joints} | {j.parent for j in joints if j.parent is not None}
+    g = {name: _poses(traj, name, idx) for name in names}
+    ground = np.broadcast_to(np.eye(4), (len(idx), 4, 4))
+    g_P = np.stack([ground if j.parent is None else g[j.parent] for j in joints], axis=1)
+    g_C = np.stack([g[j.child] for j in joints], axis=1)
+    X_PJ = np.stack([j.X_PJ for j in joints])
+    X_CJ = np.stack([j.X_CJ for j in joints])
+    g_NJp = np.einsum("knij,njl->knil", g_P, X_PJ)
+    g_NJc = np.einsum("knij,njl->knil", g_C, X_CJ)
+    return g_NJp, g_NJc, g_P[..., :3, 3], g_C[..., :3, 3]
+
+
 def view_html(
     traj: Trajectory,
     *,
@@ -116,6 +271,9 @@ def view_html(
     max_frames: int = 150,
     max_path_points: int = 2000,
     plotly_src: str | None = None,
+    joints: System | Sequence[Constraint] | None = None,
+    draw_joint_frames: bool = True,
+    joint_triad_length: float | None = None,
 ) -> str:
     """The HTML page of an interactive, offline 3-D view of ``traj``.
 
@@ -131,7 +289,7 @@ def view_html(
     triad_length : float, optional
         Length (m) of each drawn body axis; default 12 % of the scene's size (the bodies of
         an orbit would be invisible at scale), the scene being 1 m across when the bodies do
-        not move.
+        not move; with joints drawn, half the joint frames' (``joint_triad_length``).
     max_frames : int
         Most animation frames (≥ 2); see the module's notes on decimation.
     max_path_points : int
@@ -141,6 +299,15 @@ def view_html(
         page loads plotly.js from this URL, relative to the page (a file written by
         :func:`write_plotly_js`); if it is missing there the page says so and how to make a
         self-contained view.
+    joints : System or sequence of Constraint, optional
+        Whose :class:`gmuk.robots.Joint` constraints to draw (see the notes); None (default):
+        those recorded in ``traj.stats`` by :func:`with_joint_frames`, if any.
+    draw_joint_frames : bool
+        Draw each joint frame J_c's axes triad (True, default) or the links alone.
+    joint_triad_length : float, optional
+        Length (m) of each drawn joint frame axis; default 12 % of the mechanism's size (the
+        largest extent, over the animation's frames, of its joint frame origins and the
+        centres of the bodies they join).
 
     Returns
     -------
@@ -151,8 +318,19 @@ def view_html(
     Raises
     ------
     DefinitionError
-        No rigid body or point mass to draw, an empty trajectory, or a radius or length
-        that is not a finite number > 0.
+        No rigid body or point mass to draw, an empty trajectory, a radius or length that
+        is not a finite number > 0, or a joint record that does not fit the trajectory (a
+        body it names is not one of its rigid bodies).
+
+    Notes
+    -----
+    A system with joints (gmuk.robots joints between two bodies, or a body and the ground) is
+    drawn as its kinematic skeleton, animated with the bodies: each link is a thick line
+    from its body's centre (its body-frame origin) to the origin of each joint frame fixed in
+    it, ``g_NP X_PJ`` for the joints it is the parent of and ``g_NC X_CJ`` for those it is
+    the child of; the ground's link runs from N's origin to its joints' frames ``X_PJ``. Each
+    joint frame J_c (the child's, which moves with the joint) is drawn as a short triad of its
+    axes 1, 2, 3 in red, green and blue.
     """
     import plotly.io
 
@@ -164,7 +342,11 @@ def view_html(
         )
     if not isinstance(title, str):
         raise DefinitionError(f"title must be a string; got {title!r:.80}")
-    for label, value in (("central_radius", central_radius), ("triad_length", triad_length)):
+    for label, value in (
+        ("central_radius", central_radius),
+        ("triad_length", triad_length),
+        ("joint_triad_length", joint_triad_length),
+    ):
         try:
             if value is not None:
                 real_number(value, label, positive=True)
@@ -174,11 +356,24 @@ def view_html(
             ) from None
         if value is not None and not (np.isfinite(value) and value > 0):
             raise DefinitionError(f"{label} must be a finite number > 0 (m); got {value!r}")
+    if not isinstance(draw_joint_frames, (bool, np.bool_)):
+        raise DefinitionError(
+            f"draw_joint_frames must be True or False; got {draw_joint_frames!r:.80}"
+        )
+    jointed = _joints(traj, joints)
     n = len(traj)
     path_idx = decimate(n, max_path_points)
     frame_idx = decimate(n, max_frames)
 
     allpos = np.concatenate([r[path_idx] for _, r, _ in bodies])
+    if jointed:
+        g_NJp, g_NJc, r_P, r_C = _joint_poses(traj, jointed, frame_idx)
+        # (k, m, 3): every point of the skeleton at each kept frame
+        skeleton = np.concatenate([g_NJp[..., :3, 3], g_NJc[..., :3, 3], r_P, r_C], axis=1)
+        allpos = np.concatenate([allpos, skeleton.reshape(-1, 3)])
+        robot_size = float(np.ptp(skeleton, axis=1).max())
+        robot_size = robot_size if robot_size > 1e-6 else 1.0
+        joint_length = joint_triad_length if joint_triad_length is not None else 0.12 * robot_size
     size = float(np.ptp(allpos, axis=0).max()) if len(allpos) > 1 else 0.0
     if central_radius:  # the diameter, at most float64's largest (a radius near 1e308)
         central_radius = float(central_radius)
@@ -186,6 +381,8 @@ def view_html(
     size = size if size > 1e-6 else 1.0  # bodies at rest: a 1 m scene
     scale, unit = (1e-3, "km") if size > KM_ABOVE_M else (1.0, "m")
     length = triad_length if triad_length is not None else 0.12 * size
+    if jointed and triad_length is None:  # the joint frames' triads stand out, the bodies' less
+        length = 0.5 * joint_length
 
     traces: list[Any] = []
     if central_radius:
@@ -218,10 +415,67 @@ def view_html(
                 name=f"{name} path",
             )
         )
+    grounded = [k for k, j in enumerate(jointed) if j.parent is None]
+    if grounded:  # the ground's link: fixed
+        ends = np.array([jointed[k].X_PJ[:3, 3] for k in grounded]) * scale
+        x, y, z = _segments(np.zeros_like(ends), ends)
+        traces.append(
+            dict(
+                type="scatter3d",
+                x=x,
+                y=y,
+                z=z,
+                mode="lines",
+                line={"color": GROUND_COLOUR, "width": 12},
+                name="ground",
+            )
+        )
     first_dynamic = len(traces)
 
-    def dynamic(i: int) -> list[Any]:
-        """The triads (one trace per axis, all rigid bodies) and markers at output i."""
+    def skeleton_at(f: int) -> list[Any]:
+        """The links (one trace) and the joint frames' triads (one trace per axis) at the
+        kept frame ``f``."""
+        starts, ends = [], []
+        for k, joint in enumerate(jointed):
+            if joint.parent is not None:
+                starts.append(r_P[f, k])
+                ends.append(g_NJp[f, k, :3, 3])
+            starts.append(r_C[f, k])
+            ends.append(g_NJc[f, k, :3, 3])
+        x, y, z = _segments(np.array(starts) * scale, np.array(ends) * scale)
+        out = [
+            dict(
+                type="scatter3d",
+                x=x,
+                y=y,
+                z=z,
+                mode="lines",
+                line={"color": LINK_COLOUR, "width": 12},
+                name="links",
+            )
+        ]
+        if draw_joint_frames:
+            origins = g_NJc[f, :, :3, 3] * scale
+            for axis in range(3):
+                tips = origins + g_NJc[f, :, :3, axis] * joint_length * scale
+                x, y, z = _segments(origins, tips)
+                out.append(
+                    dict(
+                        type="scatter3d",
+                        x=x,
+                        y=y,
+                        z=z,
+                        mode="lines",
+                        line={"color": AXIS_COLOURS[axis], "width": 6},
+                        name=f"joint axis {axis + 1}",
+                    )
+                )
+        return out
+
+    def dynamic(f: int) -> list[Any]:
+        """The triads (one trace per axis, all rigid bodies), the markers and the skeleton at
+        the kept frame ``f``."""
+        i = int(frame_idx[f])
         out = []
         rigid = [(r[i], R[i]) for _, r, R in bodies if R is not None]
         for axis in range(3):
@@ -238,7 +492,7 @@ def view_html(
                     y=y,
                     z=z,
                     mode="lines",
-                    line={"color": AXIS_COLOURS[axis], "width": 7},
+                    line={"color": AXIS_COLOURS[axis], "width": 3 if jointed else 7},
                     name=f"body axis {axis + 1}",
                 )
             )
@@ -249,27 +503,37 @@ def view_html(
                 x=here[:, 0],
                 y=here[:, 1],
                 z=here[:, 2],
-                mode="markers+text",
+                mode="markers" if jointed else "markers+text",  # a mechanism's: on hover
                 marker={"size": 5, "color": "#111111"},
                 text=[name for name, _, _ in bodies],
                 textposition="top center",
                 name="bodies",
             )
         )
-        return out
+        return out + (skeleton_at(f) if jointed else [])
 
-    n_dynamic = 4
+    n_dynamic = 4 + (1 + 3 * draw_joint_frames if jointed else 0)
     names = [f"{traj.t[i]:.6g}" for i in frame_idx]
     frames = [
         dict(
-            data=dynamic(int(i)),
+            data=dynamic(f),
             traces=list(range(first_dynamic, first_dynamic + n_dynamic)),
             name=label,
         )
-        for i, label in zip(frame_idx, names, strict=True)
+        for f, label in enumerate(names)
     ]
     step_args = {"frame": {"duration": 0, "redraw": True}, "mode": "immediate"}
     axis = {"showbackground": False, "gridcolor": "#dddddd", "zerolinecolor": "#bbbbbb"}
+    ranges: list[dict[str, Any]] = [{}, {}, {}]
+    if jointed:  # each axis at least half the widest, so that a planar linkage is not flat
+        lo, hi = allpos.min(axis=0), allpos.max(axis=0)
+        if central_radius:  # the sphere, about N's origin, in the box too
+            lo, hi = np.minimum(lo, -central_radius), np.maximum(hi, central_radius)
+        half = np.maximum(0.5 * (hi - lo), 0.25 * float((hi - lo).max())) + joint_length
+        ranges = [
+            {"range": [(c - h) * scale, (c + h) * scale], "autorange": False}
+            for c, h in zip(0.5 * (lo + hi), half, strict=True)
+        ]
     layout = dict(
         title={"text": title or "gmuk trajectory", "x": 0.02},
         paper_bgcolor="white",
@@ -279,9 +543,9 @@ def view_html(
             "domain": {"x": [0.0, 1.0], "y": [0.12, 1.0]},  # the slider below it
             "aspectmode": "data",
             "camera": {"eye": {"x": 0.6, "y": -1.3, "z": 1.2}},
-            "xaxis": {**axis, "title": {"text": f"x_N ({unit})"}},
-            "yaxis": {**axis, "title": {"text": f"y_N ({unit})"}},
-            "zaxis": {**axis, "title": {"text": f"z_N ({unit})"}},
+            "xaxis": {**axis, **ranges[0], "title": {"text": f"x_N ({unit})"}},
+            "yaxis": {**axis, **ranges[1], "title": {"text": f"y_N ({unit})"}},
+            "zaxis": {**axis, **ranges[2], "title": {"text": f"z_N ({unit})"}},
         },
         updatemenus=[
             {
@@ -333,7 +597,7 @@ def view_html(
     # the view's time (0.8 of 1.15 s for a 150-frame FCEI view)
     # the default template, which a plotly Figure would have applied
     layout["template"] = plotly.io.templates[plotly.io.templates.default].to_plotly_json()
-    fig = {"data": traces + dynamic(int(frame_idx[0])), "frames": frames, "layout": layout}
+    fig = {"data": traces + dynamic(0), "frames": frames, "layout": layout}
     html: str = plotly.io.to_html(
         fig,
         validate=False,
@@ -414,7 +678,8 @@ def write_view(
         its path relative to the page (about 0.3 MB a page): views of many runs share one
         copy, and a page moved away from it says so when opened.
     **options
-        ``triad_length`` (m), ``max_frames``, ``max_path_points``, as :func:`view_html`.
+        ``triad_length`` (m), ``max_frames``, ``max_path_points``, ``joints``,
+        ``draw_joint_frames``, ``joint_triad_length`` (m), as :func:`view_html`.
 
     Raises
     ------

@@ -50,6 +50,7 @@ from gmuk.errors import DomainError
 from gmuk.lie import so3
 from gmuk.robots import RevoluteJoint
 from gmuk.scenarios import Option, Scenario, ScenarioResult, positive_float
+from gmuk.view import with_joint_frames
 
 NAME = "four-bar"
 DESCRIPTION = "planar four-bar linkage under gravity: one closed loop of revolute joints"
@@ -252,6 +253,7 @@ def simulate(
 def run(duration: float = 3.0, crank_rate: float = 8.0) -> ScenarioResult:
     """Release the crank at θ₂ = 0 with θ̇₂ = ``crank_rate`` (rad/s) for ``duration`` s."""
     system, joints, traj = simulate(duration, crank_rate)
+    traj = with_joint_frames(traj, system)  # the 3-D view draws the bars and joints
     E = energy(system, traj)
     pos, vel = loop_residuals(joints, traj)
     theta2 = joints["O2"].coordinates_along(traj)[:, 0]

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from gmuk.scenarios import Option, Scenario, ScenarioResult, non_negative_float, positive_float
+from gmuk.view import with_joint_frames
 
 NAME = "panda"
 DESCRIPTION = "Panda arm (URDF) falling under gravity with joint damping, against Pinocchio ABA"
@@ -74,6 +75,7 @@ def run(duration: float = 2.0, damping: float = 0.5) -> ScenarioResult:
     v0 = np.zeros(robot.nv)
     t = np.linspace(0.0, duration, round(200 * duration) + 1)
     traj = robot.system.simulate(robot.state(READY, v0), (0.0, duration), t_eval=t)
+    traj = with_joint_frames(traj, robot.system)  # the 3-D view draws the links and joints
     q = robot.configuration(traj)
     v = robot.velocity(traj)
     q_ref, v_ref = pinocchio_reference(robot, READY, v0, t, damping)

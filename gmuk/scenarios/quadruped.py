@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from gmuk.scenarios import Option, Scenario, ScenarioResult, positive_float
+from gmuk.view import with_joint_frames
 
 NAME = "quadruped"
 DESCRIPTION = "Solo12 (URDF, floating base) landing and standing on four exact contacts"
@@ -70,6 +71,7 @@ def run(duration: float = 0.5) -> ScenarioResult:
     robot, system, state, contacts = build()
     t = np.linspace(0.0, duration, round(100 * duration) + 1)
     traj = simulate_with_impacts(system, state, (0.0, duration), t_eval=t, rtol=1e-8, atol=1e-8)
+    traj = with_joint_frames(traj, system)  # the 3-D view draws the links and joints
     kkt = contact_kkt(system, traj)
     weight = -float(robot.model.gravity.linear[2]) * sum(b.mass for b in robot.bodies)
     forces = np.column_stack([kkt[c.name].multiplier[:, 0] for c in contacts])

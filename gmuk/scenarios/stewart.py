@@ -53,6 +53,7 @@ from gmuk._validation import FloatArray
 from gmuk.lie import so3
 from gmuk.robots import JointSpringDamper, PrismaticJoint, SphericalJoint, UniversalJoint
 from gmuk.scenarios import Option, Scenario, ScenarioResult, positive_float
+from gmuk.view import with_joint_frames
 
 NAME = "stewart"
 DESCRIPTION = "Stewart–Gough platform (6-UPS) held under gravity by PD leg actuators: six loops"
@@ -239,6 +240,7 @@ def run(
 ) -> ScenarioResult:
     """Release the platform at rest at its nominal pose under gravity, legs on PD."""
     system, parts, traj = simulate(duration, stiffness, damping)
+    traj = with_joint_frames(traj, system)  # the 3-D view draws the legs and joints
     plat = traj.body("platform")
     sag = HEIGHT - plat.position[:, 2]
     tilt = np.array([np.linalg.norm(so3.log(R)) for R in plat.R])

@@ -1,0 +1,316 @@
+"""The 3-D view of a system with joints (issue #28, item 5): each link a thick line from its
+body's centre to the origins of the joint frames fixed in it, the ground's link from N's origin,
+and each joint frame J_c's axes triad, animated with the trajectory; the robot scenarios hand
+their joints to the view; headless Chromium renders and animates the page with no JavaScript
+error."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_view import FLAGS, render
+
+import gmuk
+from gmuk.errors import DefinitionError
+from gmuk.robots import Joint
+from gmuk.scenarios import four_bar, panda
+from gmuk.trajectory import load_trajectory
+from gmuk.view import (
+    JOINT_FRAMES_KEY,
+    LINK_COLOUR,
+    decimate,
+    joint_frames,
+    view_html,
+    with_joint_frames,
+    write_view,
+)
+
+
+def trajectory_through(states: list[gmuk.State]) -> gmuk.Trajectory:
+    """A Trajectory whose outputs are ``states`` (kinematics only: no integration)."""
+    lay = states[0].layout
+    n, n_dof = len(states), sum(lay.dofs)
+    zeros = np.zeros((n, n_dof))
+    return gmuk.Trajectory(
+        t=np.array([s.t for s in states]),
+        g_NB=np.array([s.g for s in states]),
+        V_B=np.array([s.V for s in states]),
+        x=np.zeros((n, 0)),
+        xdot=np.zeros((n, 0)),
+        z=np.zeros((n, 0)),
+        acceleration=zeros,
+        constraint_acceleration=zeros,
+        constraint_force=zeros,
+        control_force=zeros,
+        unmodeled_force=zeros,
+        multipliers=np.zeros((n, 0)),
+        residual=np.zeros(n),
+        rank=np.zeros(n, dtype=int),
+        body_names=tuple(lay.names),
+        body_kinds=tuple(k.value for k in lay.kinds),
+        body_dofs=tuple(lay.dofs),
+    )
+
+
+def four_bar_turning(n: int = 25) -> tuple[gmuk.System, gmuk.Trajectory]:
+    """The four-bar at n crank angles over a turn (states on its loop, at 8 rad/s)."""
+    system, _, _ = four_bar.build()
+    theta2 = np.linspace(0.0, 2.0 * np.pi, n)
+    traj = trajectory_through([four_bar.state_at(system, float(a), 8.0) for a in theta2])
+    return system, replace(traj, t=theta2 / 8.0)
+
+
+@pytest.fixture(scope="module")
+def linkage() -> tuple[gmuk.System, gmuk.Trajectory]:
+    return four_bar_turning()
+
+
+@pytest.fixture(scope="module")
+def arm() -> tuple[gmuk.System, gmuk.Trajectory]:
+    """The Panda at 12 configurations between its ready posture and a bent one."""
+    robot = panda.build(damping=0.0)
+    bent = panda.READY + np.array([0.6, 0.4, -0.5, 0.7, 0.9, -0.8, 1.2])
+    states = [
+        robot.state(panda.READY + s * (bent - panda.READY), np.zeros(robot.nv), t=s)
+        for s in np.linspace(0.0, 1.0, 12)
+    ]
+    return robot.system, trajectory_through(states)
+
+
+def figure(page: str) -> tuple[list[dict], list[dict]]:
+    """(data, frames) of a view page."""
+    plot = r"Plotly\.newPlot\(\s*\"[^\"]+\",\s*(\[.*?\]),\s*\{"
+    add = r"Plotly\.addFrames\(\s*['\"][^'\"]+['\"],\s*(\[.*\])\);"
+    return json.loads(re.search(plot, page, re.S)[1]), json.loads(re.search(add, page, re.S)[1])
+
+
+def segments(trace: dict) -> np.ndarray:
+    """The (start, end) points (k, 2, 3) of a trace of segments separated by None."""
+    xyz = [[np.nan if v is None else v for v in trace[c]] for c in "xyz"]
+    points = np.array(xyz, dtype=float).T
+    assert np.isnan(points[2::3]).all()
+    return np.stack([points[0::3], points[1::3]], axis=1)
+
+
+def named(traces: list[dict], name: str) -> dict:
+    (trace,) = [t for t in traces if t.get("name") == name]
+    return trace
+
+
+def expected_skeleton(system: gmuk.System, state: gmuk.State, length: float):
+    """The links' segments (body centre → joint frame origin) and the J_c triads' segments
+    of every joint, from the Joint objects and the State (independent of gmuk.view)."""
+    links, axes, ground = [], [[], [], []], []
+    for joint in system.constraints:
+        if not isinstance(joint, Joint):
+            continue
+        g_NJc = state.pose(joint.child) @ joint.child_frame
+        if joint.parent is None:
+            ground.append((np.zeros(3), joint.parent_frame[:3, 3]))
+        else:
+            g_NP = state.pose(joint.parent)
+            links.append((g_NP[:3, 3], (g_NP @ joint.parent_frame)[:3, 3]))
+        links.append((state.pose(joint.child)[:3, 3], g_NJc[:3, 3]))
+        for a in range(3):
+            axes[a].append((g_NJc[:3, 3], g_NJc[:3, 3] + length * g_NJc[:3, a]))
+    return np.array(links), [np.array(a) for a in axes], np.array(ground)
+
+
+@pytest.mark.parametrize("which", ["linkage", "arm"])
+def test_links_end_at_the_joint_frames_at_every_frame(which, request):
+    system, traj = request.getfixturevalue(which)
+    length = 0.05
+    page = view_html(traj, joints=system, max_frames=7, joint_triad_length=length)
+    data, frames = figure(page)
+    kept = decimate(len(traj), 7)
+    assert [f["name"] for f in frames] == [f"{traj.t[i]:.6g}" for i in kept]
+    for f, i in enumerate(kept):
+        links, axes, ground = expected_skeleton(system, traj.state(int(i)), length)
+        drawn = frames[f]["data"]
+        # metres (the scene is under 100 km): equal to round-off
+        np.testing.assert_allclose(segments(named(drawn, "links")), links, rtol=0, atol=1e-12)
+        for a in range(3):
+            np.testing.assert_allclose(
+                segments(named(drawn, f"joint axis {a + 1}")), axes[a], rtol=0, atol=1e-12
+            )
+        if f == 0:  # the first frame is the page's initial data
+            np.testing.assert_allclose(segments(named(data, "links")), links, rtol=0, atol=1e-12)
+    if len(ground):  # the four-bar: O2 and O4; the Panda: its base
+        np.testing.assert_allclose(segments(named(data, "ground")), ground, rtol=0, atol=0)
+    # the links move: the middle frame's differ from the first's
+    first, middle = (segments(named(frames[k]["data"], "links")) for k in (0, 3))
+    assert np.abs(first - middle).max() > 0.05
+
+
+def test_the_number_of_traces_is_the_paths_the_ground_and_the_moving_parts(linkage, arm):
+    system, traj = linkage
+    for draw, moving in ((True, 4 + 1 + 3), (False, 4 + 1)):
+        data, frames = figure(view_html(traj, joints=system, draw_joint_frames=draw))
+        static = 3 + 1  # three bars' paths, the ground
+        assert len(data) == static + moving
+        assert [t["name"] for t in data[:static]] == [
+            "crank path",
+            "coupler path",
+            "rocker path",
+            "ground",
+        ]
+        assert all(fr["traces"] == list(range(static, static + moving)) for fr in frames)
+        assert all(len(fr["data"]) == moving for fr in frames)
+        # two segments for a joint between bars (A, B), one for a joint to the ground
+        assert len(segments(named(data, "links"))) == 2 + 2 + 1 + 1
+        assert len(segments(named(data, "ground"))) == 2
+    # the Panda: seven links' paths, its base on the ground; seven joints, one to the ground
+    system, traj = arm
+    data, _ = figure(view_html(traj, joints=system))
+    assert len(data) == 7 + 1 + 8
+    assert len(segments(named(data, "links"))) == 2 * 6 + 1
+    # a trajectory without joints is drawn as before: paths, body axes, markers
+    plain, _ = figure(view_html(traj))
+    assert [t["name"] for t in plain[7:]] == [
+        "body axis 1",
+        "body axis 2",
+        "body axis 3",
+        "bodies",
+    ]
+
+
+def test_the_joints_travel_with_the_trajectory_through_save_and_load(linkage, tmp_path):
+    system, traj = linkage
+    marked = with_joint_frames(traj, system)
+    assert JOINT_FRAMES_KEY not in traj.stats  # a new Trajectory; the arrays shared
+    assert marked.g_NB is traj.g_NB
+    records = marked.stats[JOINT_FRAMES_KEY]
+    assert [(r["name"], r["parent"], r["child"]) for r in records] == [
+        ("O2", None, "crank"),
+        ("A", "crank", "coupler"),
+        ("B", "coupler", "rocker"),
+        ("O4", None, "rocker"),
+    ]
+    assert records == joint_frames(system.constraints)
+    loaded = load_trajectory(marked.save(tmp_path / "four_bar.npz"))
+    # JSON holds the frames exactly: the same figure as from the System itself
+    assert figure(view_html(loaded)) == figure(view_html(traj, joints=system))
+    assert figure(view_html(marked)) == figure(view_html(traj, joints=system))
+
+
+def test_a_view_refuses_joints_that_do_not_fit_the_trajectory(linkage):
+    system, traj = linkage
+    good = joint_frames(system)
+    wrong_body = [{**good[1], "child": "crankshaft"}]
+    bent = [{**good[0], "X_PJ": (2.0 * np.eye(4)).tolist()}]
+    for records, message in (
+        (wrong_body, r"its child 'crankshaft' is not a rigid body of the trajectory"),
+        (bent, r"stats\['joint_frames'\]\[0\] must be a joint record"),
+        ([{"name": "O2"}], r"must be a joint record .*'parent'"),
+        ("O2", "must be a list of joint records"),
+    ):
+        odd = replace(traj, stats={JOINT_FRAMES_KEY: records})
+        with pytest.raises(DefinitionError, match=message):
+            view_html(odd)
+    with pytest.raises(DefinitionError, match="joints must be a System or a sequence"):
+        view_html(traj, joints=42)  # type: ignore[arg-type]
+    with pytest.raises(DefinitionError, match="draw_joint_frames must be True or False"):
+        view_html(traj, joints=system, draw_joint_frames="no")  # type: ignore[arg-type]
+    with pytest.raises(DefinitionError, match="joint_triad_length must be a finite number > 0"):
+        view_html(traj, joints=system, joint_triad_length=-0.1)
+
+
+@pytest.mark.parametrize(
+    ("name", "duration", "n_joints", "n_grounded"),
+    [("panda", 0.05, 7, 1), ("four-bar", 0.02, 4, 2), ("stewart", 0.01, 18, 6)],
+)
+def test_the_robot_scenarios_hand_their_joints_to_gmuk_runs_view(
+    name, duration, n_joints, n_grounded, tmp_path
+):
+    """The scenario's trajectory carries its joints, so ``gmuk run``'s view.html (and ``gmuk
+    view`` of the run folder, from trajectory.npz) draws the mechanism."""
+    from gmuk.scenarios import get
+
+    result = get(name).run(duration=duration)
+    traj = result.trajectories[result.primary]
+    records = traj.stats[JOINT_FRAMES_KEY]
+    assert len(records) == n_joints
+    assert sum(r["parent"] is None for r in records) == n_grounded
+    if name == "panda":
+        assert [r["name"] for r in records] == list(result.data["robot"].joints)
+    page = write_view(load_trajectory(traj.save(tmp_path / "trajectory.npz")), tmp_path / "v.html")
+    data, _ = figure(page.read_text())
+    drawn = [t["name"] for t in data]
+    assert "ground" in drawn and "links" in drawn and "joint axis 3" in drawn
+    assert len(segments(named(data, "links"))) == 2 * n_joints - n_grounded
+
+
+# --- headless Chromium --------------------------------------------------------------------------
+
+#: A caught error or rejected promise marks <html data-js-error="its message">; once plotly has
+#: added the frames, the page animates to the last one and marks <body data-animated="yes">.
+WATCH = """<script>
+function caught(text) { document.documentElement.setAttribute('data-js-error', text); }
+window.addEventListener('error', function (e) { caught(String(e.message)); });
+window.addEventListener('unhandledrejection', function (e) { caught(String(e.reason)); });
+</script>"""
+ANIMATE = """<script>
+var tries = 0, timer = setInterval(function () {
+  var gd = document.querySelector('.plotly-graph-div');
+  var frames = gd && gd._transitionData && gd._transitionData._frames;
+  if ((!frames || !frames.length) && ++tries < 200) { return; }
+  clearInterval(timer);
+  Plotly.animate(gd, [frames[frames.length - 1].name],
+                 {frame: {duration: 0, redraw: true}, transition: {duration: 0},
+                  mode: 'immediate'})
+    .then(function () { document.body.setAttribute('data-animated', 'yes'); });
+}, 50);
+</script>"""
+
+
+def watched(page: str) -> str:
+    """``page`` with the error watcher first in its head and the animation at its end."""
+    return page.replace("<head>", "<head>" + WATCH, 1).replace("</body>", ANIMATE + "</body>", 1)
+
+
+def error_and_dom(chromium: str, path: Path, profile: Path) -> tuple[str | None, str]:
+    """The page's script error (None if none) and its DOM after headless Chromium ran it."""
+    text = subprocess.run(
+        [chromium, *FLAGS, f"--user-data-dir={profile}", "--dump-dom", path.resolve().as_uri()],
+        check=True,
+        capture_output=True,
+        text=True,
+        timeout=180,
+    ).stdout
+    found = re.search(r'<html[^>]*data-js-error="([^"]*)"', text)
+    return (found[1] if found else None), text
+
+
+def link_pixels(image: np.ndarray) -> int:
+    """Pixels of the links' colour, LINK_COLOUR (#rrggbb), to within 12 in each channel."""
+    colour = np.array([int(LINK_COLOUR[k : k + 2], 16) for k in (1, 3, 5)])
+    return int((np.abs(image - colour).max(axis=2) < 12).sum())
+
+
+def test_chromium_draws_and_animates_a_robot_view_with_no_script_error(chromium, tmp_path, arm):
+    system, traj = arm
+    page = view_html(traj, joints=system, title="Panda")
+    (tmp_path / "arm.html").write_text(watched(page))
+    error, text = error_and_dom(chromium, tmp_path / "arm.html", tmp_path / "p1")
+    assert error is None and 'data-animated="yes"' in text, error
+    # the watcher catches an error: a page whose script fails says so
+    (tmp_path / "bad.html").write_text(
+        watched(page.replace("</body>", "<script>null.x</script></body>"))
+    )
+    error, _ = error_and_dom(chromium, tmp_path / "bad.html", tmp_path / "p2")
+    assert error is not None and "null" in error, error
+    # the links are drawn: thousands of pixels of their colour, none in the same view without
+    image, requests = render(chromium, write_view(traj, tmp_path / "v.html", joints=system),
+                             tmp_path / "v.png")  # fmt: skip
+    bare, _ = render(chromium, write_view(traj, tmp_path / "b.html"), tmp_path / "b.png")
+    assert requests == []
+    assert link_pixels(image) > 1_000 and link_pixels(bare) < 50, (
+        link_pixels(image),
+        link_pixels(bare),
+    )
