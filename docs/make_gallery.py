@@ -211,6 +211,19 @@ COMMANDS: dict[str, tuple[str, str, list[tuple[str, str]], str]] = {
         ],
         "tutorials/gnc_wheels",
     ),
+    "lunar-rcs": (
+        "",
+        "none (beyond the thesis: FCCL's ideal wrench flown on RCS thrusters, issue #29)",
+        [
+            (
+                "tracking",
+                "Attitude and position errors from the LVLH reference, and the mass the "
+                "thrusters spend; the dashed line is the umbra entry.",
+            ),
+            ("on_times", "Every firing: one tick per control period a thruster fires."),
+        ],
+        "thrusters",
+    ),
     "lunar-flyby": (
         "--degree 150",
         "none (beyond the thesis: a hyperbolic lunar flyby stopped at periapsis, issue #29)",

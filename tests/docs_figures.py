@@ -2420,3 +2420,32 @@ ALLOWED += [
     (FLY, "v∞ = 1 km/s, h_p = 100 km, r₀ = 10 000 km", "the default options, inputs"),
     (FLY, "well under 1e-12 s", _THRESHOLD + " (issue #29's event accuracy)"),
 ]
+
+# docs/thrusters.rst ---------------------------------------------------------------------------
+THR = "docs/thrusters.rst"
+RUNS["lunar-rcs"] = Run("lunar-rcs", seconds=6)
+_add(
+    THR,
+    "lunar-rcs",
+    ("t = 222.547 s", "eclipse_entry_s", "t = {:.3f} s", "umbra entry"),
+    ("from 0.0327 rad", "attitude_error_initial_rad", "from {:.4f} rad", "attitude error"),
+    ("to 0.00111 rad", "attitude_error_final_rad", "to {:.5f} rad", "attitude error"),
+    ("from 6.16 m", "position_error_initial_m", "from {:.2f} m", "position error"),
+    ("5.80 m under", "position_error_final_m", "{:.2f} m under", "position error"),
+    ("190 firings", "firings", "{} firings"),
+    ("spending 0.674 kg", "propellant_kg", "spending {:.3f} kg"),
+    ("force 233 N", "largest_commanded_force_N", "force {:.0f} N"),
+    ("torque 206 N·m", "largest_commanded_torque_Nm", "torque {:.0f} N·m"),
+)
+ALLOWED += [
+    (THR, "2.85 MN", "the FCCL peak force, quoted from issue #29 (docs/scenarios/chapter5.rst)"),
+    (THR, "7063 kg", _INPUT),
+    (THR, "reference, from 6.16 m and", _INPUT),
+    (THR, "0.0327 rad off, with FCCL", _INPUT),
+    (THR, "every 0.5 s", _INPUT),
+    (THR, "twelve 445 N thrusters", _INPUT),
+    (THR, "on 2 m arms (I_sp = 290 s", _INPUT),
+    (THR, "bit 6.23 N·s, on-time quantum 2 ms", _INPUT),
+    (THR, "g₀ = 9.80665 m/s²", "standard gravity, a constant"),
+    (THR, "to 1e-10 (relative)", _THRESHOLD + " (tests/actuators/test_thrusters.py)"),
+]

@@ -79,6 +79,7 @@ SCENARIOS: dict[str, str] = {
     "smd-compare": "gmuk.scenarios.smd_compare:SCENARIO",
     "maintenance": "gmuk.scenarios.maintenance:SCENARIO",
     "rw-pointing": "gmuk.scenarios.rw_pointing:SCENARIO",
+    "lunar-rcs": "gmuk.scenarios.lunar_rcs:SCENARIO",
     "lunar-flyby": "gmuk.scenarios.lunar_flyby:SCENARIO",
     "four-bar": "gmuk.scenarios.four_bar:SCENARIO",
     "stewart": "gmuk.scenarios.stewart:SCENARIO",
