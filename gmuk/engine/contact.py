@@ -285,8 +285,10 @@ class _GapEvent(Event):
 
 def _join(parts: Sequence[Trajectory], impacts: list[EventRecord]) -> Trajectory:
     """One trajectory of consecutive segments, with the impacts counted and last in its
-    events."""
-    events = tuple(e for p in parts for e in p.events if e not in impacts) + tuple(impacts)
+    events: recorded, not terminal (each ended a segment, not the run)."""
+    events = tuple(e for p in parts for e in p.events if e not in impacts) + tuple(
+        dataclasses.replace(e, terminal=False) for e in impacts
+    )
     return segments.join(parts, stats={"impacts": len(impacts)}, events=events)
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -123,7 +124,7 @@ def test_an_impact_follows_newtons_law_of_restitution():
     assert abs(floor.gaps(after)[1][0]) < 1e-12
 
 
-def test_a_bouncing_ball_hits_at_the_closed_form_times_and_comes_to_rest():
+def test_a_bouncing_ball_hits_at_the_closed_form_times_and_comes_to_rest(tmp_path: Path) -> None:
     """Drop from h: impacts at t₁ = √(2h/g), then every 2 eⁿ v₁ / g; the series sums to
     t₁ (1 + 2e/(1 − e)), after which the ball rests (impacts below 1 mm/s are plastic)."""
     e, h, g0 = 0.8, 1.0, 9.81
@@ -150,6 +151,10 @@ def test_a_bouncing_ball_hits_at_the_closed_form_times_and_comes_to_rest():
     end = traj.state(-1)
     assert abs(end.pose("ball")[2, 3] - 0.1) < 1e-9 and np.abs(end.V).max() < 1e-9
     assert traj.stats["impacts"] == len(times)
+    # the impacts ended segments, not the run: recorded events, and the run saves and loads
+    assert not any(ev.terminal for ev in traj.events)
+    back = gmuk.load_trajectory(traj.save(tmp_path / "ball.npz"))
+    assert [ev.t for ev in back.events] == list(times)
 
 
 def test_a_box_dropped_on_a_plane_comes_to_rest_with_kkt_to_round_off():
