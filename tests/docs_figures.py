@@ -789,6 +789,40 @@ def _add(doc: str, run: str, *rows: tuple[Any, ...]) -> None:
         FIGURES.append(Figure(doc, text, run, key, fmt, near, kind, offset))
 
 
+# docs/tutorials/gnc_thrusters.rst ---------------------------------------------------------------
+def _tutorial_8() -> dict[str, Any]:
+    """The numbers tutorial 8 prints in its full run (not --quick)."""
+    import runpy
+
+    path = ROOT / "examples" / "tutorials" / "t8_gnc_thrusters.py"
+    return runpy.run_path(str(path), run_name="tutorial")["main"]([])
+
+
+RUNS["tutorial-8"] = Run(
+    "(examples/tutorials/t8_gnc_thrusters.py)", seconds=12, function=_tutorial_8, slow_anyway=True
+)
+_add(
+    "docs/tutorials/gnc_thrusters.rst",
+    "tutorial-8",
+    (
+        "``refused_without_scaled_forces: 1``",
+        "refused_without_scaled_forces",
+        "``refused_without_scaled_forces: {:.0f}``",
+    ),
+    ("t = 119.75 s", "umbra_entry_s", "t = {:.2f} s", "enters"),
+    ("t = 385.69 s", "umbra_exit_s", "t = {:.2f} s", "leaves it"),
+    ("t = 487.05 s", "sunlight_s", "t = {:.2f} s", "full"),
+    ("from t = 80 s on", "within_2deg_from_s", "from t = {:.0f} s on", "within 2°"),
+    ("164 firings", "firings", "{:.0f} firings"),
+    ("2.09 g of propellant", "propellant_kg*1000", "{:.2f} g of propellant"),
+    ("< 1e-12 kg", "propellant_minus_firings_kg", "< {:.0e} kg", "on-time × flow", "below"),
+    ("error is 0.0164 rad", "final_attitude_error_rad", "error is {:.4f} rad"),
+    ("rate 3.3e-4 rad/s", "final_rate_rad_s", "rate {:.1e} rad/s"),
+    ("within 0.0200 rad", "dead_band_rad", "within {:.4f} rad", "dead band"),
+    ("pressure is 8.97e-6 N", "srp_force_final_N", "pressure is {:.2e} N"),
+    ("spent is 1.25e-10 N", "srp_correction_final_N", "spent is {:.2e} N"),
+)
+
 # docs/robotics.rst -----------------------------------------------------------------------------
 _add(
     "docs/robotics.rst",

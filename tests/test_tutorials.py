@@ -74,6 +74,19 @@ CHECKS = {
         and r["bearing_spin_torque_max_Nm"] < 1e-14 * r["bearing_torque_max_Nm"]
         and r["bearing_torque_max_Nm"] > 0.01
     ),
+    # the System refuses the SRP unless scaled; the mass spent is the firings' propellant;
+    # the slew ends in the dead band the minimum impulse bit leaves; the umbra is entered
+    # (the quick run's 150 s) and no radiation pressure reaches it there
+    "t8_gnc_thrusters.py": lambda r: (
+        r["refused_without_scaled_forces"] == 1
+        and r["propellant_minus_firings_kg"] < 1e-12
+        and r["firings"] > 0
+        and r["within_2deg_from_s"] < 150.0
+        and r["final_attitude_error_rad"] < 2.0 * r["dead_band_rad"]
+        and r["t_final_s"] == 150.0
+        and 0.0 < r["umbra_entry_s"] < r["t_final_s"]
+        and r["srp_force_final_N"] == 0.0
+    ),
 }
 
 
