@@ -666,16 +666,16 @@ def simulate_pulsed(
             # switch; requested times: each segment keeps those in (a, b].
             drop = times is None and not (last or stopped)
             parts.append(segments.trimmed(seg, times, drop_last=drop))
-            if stopped:
+            if stopped:  # the state it reached (the propellant spent up to there)
+                state = seg.state(len(seg) - 1) if len(seg) else state
                 done = True
                 break
             state = seg.state(len(seg) - 1)
             a = float(b)
         t = t_next
         done = done or t >= t1
-    kept = [p for p in parts if len(p)] or parts[-1:]
-    spent = float(state0.z[zs.start] - kept[-1].z[-1, zs.start])
-    joined = segments.join(kept, stats={"firings": firings, "propellant": spent})
+    spent = float(state0.z[zs.start] - state.z[zs.start])
+    joined = segments.join(parts, stats={"firings": firings, "propellant": spent})
     return check_drift(system, joined, options.get("drift_tol", 1e-6))
 
 

@@ -360,7 +360,7 @@ def simulate_with_impacts(
         t = hit.t
     from gmuk.engine.integrate import check_drift
 
-    joined = _join([p for p in parts if len(p)] or parts[-1:], impacts)
+    joined = _join(parts, impacts)
     return check_drift(system, joined, options.get("drift_tol", 1e-6))
 
 

@@ -59,14 +59,17 @@ def join(
     events: Sequence[EventRecord] | None = None,
 ) -> Trajectory:
     """One trajectory of consecutive segments: their time-major fields concatenated, the
-    step counts summed, the last segment's status and message, its other ``stats`` updated
-    with ``stats``, and the segments' events in time order (or ``events`` when given)."""
-    first, last = parts[0], parts[-1]
+    step counts summed, the last segment's status and message (even when it kept no output:
+    an interrupted or failed last piece), its other ``stats`` updated with ``stats``, and the
+    segments' events in time order (or ``events`` when given)."""
+    last = parts[-1]
+    kept = [p for p in parts if len(p)] or [last]
+    first = kept[0]
     fields: dict[str, Any] = {}
     for f in dataclasses.fields(Trajectory):
         value = getattr(first, f.name)
         if isinstance(value, np.ndarray) and value.shape[:1] == first.t.shape[:1]:
-            fields[f.name] = np.concatenate([getattr(p, f.name) for p in parts])
+            fields[f.name] = np.concatenate([getattr(p, f.name) for p in kept])
     merged = dict(last.stats)
     for key in ("n_rhs", "n_steps", "n_rejected"):
         if all(key in p.stats for p in parts):

@@ -15,7 +15,7 @@ Udwadia–Kalaba solve of the tracking constraint (:class:`gmuk.ConfigurationTra
 gravity gradient modeled) and the Morse–Lyapunov law (default gains) would apply — the
 *ideal* wrench of Section 5.1 — evaluated at the current state. Twelve thrusters in six pure
 couples (:func:`gmuk.actuators.couple_thrusters`: 2 m arms, 445 N each, like the Apollo LM's
-RCS; I_sp = 290 s, minimum impulse bit 0.445 × 14 ms, on-time quantum 2 ms) deliver it
+RCS; I_sp = 290 s, minimum impulse bit F_max × 14 ms, on-time quantum 2 ms) deliver it
 (:meth:`~gmuk.actuators.ThrusterSet.allocate`, then pulse-width modulation;
 :func:`gmuk.actuators.simulate_pulsed`). The plant feels only the gravity gradient of the
 point-mass Moon (Eq. 23) and the thrust, with the mass the thrusters spend
@@ -62,7 +62,7 @@ ARM = 2.0
 MAX_THRUST = 445.0
 ISP = 290.0
 ON_TIME_QUANTUM = 0.002
-MIN_IMPULSE_BIT = MAX_THRUST * 0.014
+MIN_ON_TIME = 0.014  # s: the minimum impulse bit is F_max × 14 ms
 PROPELLANT = 500.0
 POSITION_OFFSET = np.array([5.0, -3.0, 2.0])
 VELOCITY_OFFSET = np.array([0.02, -0.01, 0.01])
@@ -83,7 +83,7 @@ def build(max_thrust: float = MAX_THRUST) -> dict[str, Any]:
             ARM,
             max_thrust,
             ISP,
-            min_impulse_bit=MIN_IMPULSE_BIT,
+            min_impulse_bit=max_thrust * MIN_ON_TIME,
             on_time_quantum=ON_TIME_QUANTUM,
         ),
         dry_mass=sc.mass - PROPELLANT,

@@ -370,6 +370,23 @@ def test_pulsed_run_never_spends_below_the_dry_mass() -> None:
     assert np.all(np.array(traj.stats["firings"]["on_times"])[-5:] == 0.0)
 
 
+def test_events_between_requested_outputs_are_kept() -> None:
+    # The rate crossing falls in pieces of the run that keep no output time: its record must
+    # still reach the joined trajectory, as in the run that outputs every step.
+    cross = gmuk.Event(lambda t, s: 0.02 - abs(s.twist("sc")[2]), direction=0, name="rate")
+    _, sparse = _slew(60.0, events=[cross], t_eval=[0.0, 30.0, 60.0])
+    _, every = _slew(60.0, events=[cross])
+    assert len(every.events) >= 2
+    assert [e.t for e in sparse.events] == [e.t for e in every.events]
+    assert sparse.status == every.status == "success"
+
+
+def test_a_failing_piece_fails_the_pulsed_run_even_without_outputs_of_its_own() -> None:
+    _, traj = _slew(10.0, t_eval=[0.0, 10.0], max_steps=2, on_failure="return")
+    assert traj.status == "failed" and "steps" in traj.message
+    assert traj.t.tolist() == [0.0]
+
+
 def test_a_terminal_event_ends_a_pulsed_run() -> None:
     stop = gmuk.Event(lambda t, s: 0.03 - abs(s.twist("sc")[2]), terminal=True, name="rate")
     _, traj = _slew(100.0, events=[stop])
