@@ -311,6 +311,8 @@ class ThrusterSet(Sequence[Thruster]):
         )
         f = np.clip(fit.x, 0.0, fmax)
         target = self.B @ f
+        if not f.any():  # nothing to fire (a zero command): no program to solve
+            return Allocation(f, target, float(np.linalg.norm(D * (target - W))))
         # Among the thrusts with the same wrench, the least propellant (a linear program;
         # the fit is one feasible point, so it only fails on round-off, and then keeps it).
         lp = scipy.optimize.linprog(
@@ -487,13 +489,13 @@ class Thrusters(Controller):
         m, valves = float(z[0]), np.asarray(z[1:], dtype=float)
         if not m > 0.0:
             raise SimulationError(f"{self.name}: the spacecraft's mass is {m!r} kg")
-        if np.any(valves < -VALVE_TOL) or np.any(valves > 1.0 + VALVE_TOL):
+        if not (valves.min() >= -VALVE_TOL and valves.max() <= 1.0 + VALVE_TOL):
             raise SimulationError(
                 f"{self.name}: valve openings must lie in [0, 1]; got {valves.tolist()}"
             )
         f = valves * self.thrusters.max_thrust
         z_dot = np.zeros(len(z))
-        z_dot[0] = self.thrusters.mass_rate(f)
+        z_dot[0] = -float(valves @ self.thrusters.mass_flow)  # ṁ = −Σ v_i F_max,i / (I_sp,i g₀)
         ratio = self.initial_mass / m
         u = ratio * (self.thrusters.B @ f)
         (body,) = self.bodies
