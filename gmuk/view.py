@@ -132,6 +132,15 @@ def _segments(starts: FloatArray, ends: FloatArray) -> tuple[list[Any], list[Any
     return xs, ys, zs
 
 
+def _segment_trace(
+    starts: Any, ends: Any, colour: str | None, width: float, name: str
+) -> dict[str, Any]:
+    """One plotly trace of line segments start→end (k, 3) of one colour and width."""
+    x, y, z = _segments(np.asarray(starts), np.asarray(ends))
+    line: dict[str, Any] = {"width": width, **({} if colour is None else {"color": colour})}
+    return dict(type="scatter3d", x=x, y=y, z=z, mode="lines", line=line, name=name)
+
+
 # --- joints: the links and the joint frames ------------------------------------------------------
 
 
@@ -418,18 +427,7 @@ def view_html(
     grounded = [k for k, j in enumerate(jointed) if j.parent is None]
     if grounded:  # the ground's link: fixed
         ends = np.array([jointed[k].X_PJ[:3, 3] for k in grounded]) * scale
-        x, y, z = _segments(np.zeros_like(ends), ends)
-        traces.append(
-            dict(
-                type="scatter3d",
-                x=x,
-                y=y,
-                z=z,
-                mode="lines",
-                line={"color": GROUND_COLOUR, "width": 12},
-                name="ground",
-            )
-        )
+        traces.append(_segment_trace(np.zeros_like(ends), ends, GROUND_COLOUR, 12, "ground"))
     first_dynamic = len(traces)
 
     def skeleton_at(f: int) -> list[Any]:
@@ -442,33 +440,17 @@ def view_html(
                 ends.append(g_NJp[f, k, :3, 3])
             starts.append(r_C[f, k])
             ends.append(g_NJc[f, k, :3, 3])
-        x, y, z = _segments(np.array(starts) * scale, np.array(ends) * scale)
         out = [
-            dict(
-                type="scatter3d",
-                x=x,
-                y=y,
-                z=z,
-                mode="lines",
-                line={"color": LINK_COLOUR, "width": 12},
-                name="links",
+            _segment_trace(
+                np.array(starts) * scale, np.array(ends) * scale, LINK_COLOUR, 12, "links"
             )
         ]
         if draw_joint_frames:
             origins = g_NJc[f, :, :3, 3] * scale
             for axis in range(3):
                 tips = origins + g_NJc[f, :, :3, axis] * joint_length * scale
-                x, y, z = _segments(origins, tips)
                 out.append(
-                    dict(
-                        type="scatter3d",
-                        x=x,
-                        y=y,
-                        z=z,
-                        mode="lines",
-                        line={"color": AXIS_COLOURS[axis], "width": 6},
-                        name=f"joint axis {axis + 1}",
-                    )
+                    _segment_trace(origins, tips, AXIS_COLOURS[axis], 6, f"joint axis {axis + 1}")
                 )
         return out
 
@@ -478,23 +460,12 @@ def view_html(
         i = int(frame_idx[f])
         out = []
         rigid = [(r[i], R[i]) for _, r, R in bodies if R is not None]
+        starts = np.array([r for r, _ in rigid]).reshape(-1, 3) * scale
         for axis in range(3):
-            if rigid:
-                starts = np.array([r for r, _ in rigid]) * scale
-                ends = starts + np.array([R[:, axis] for _, R in rigid]) * length * scale
-                x, y, z = _segments(starts, ends)
-            else:
-                x = y = z = []
+            ends = starts + np.array([R[:, axis] for _, R in rigid]).reshape(-1, 3) * length * scale
+            width = 3 if jointed else 7
             out.append(
-                dict(
-                    type="scatter3d",
-                    x=x,
-                    y=y,
-                    z=z,
-                    mode="lines",
-                    line={"color": AXIS_COLOURS[axis], "width": 3 if jointed else 7},
-                    name=f"body axis {axis + 1}",
-                )
+                _segment_trace(starts, ends, AXIS_COLOURS[axis], width, f"body axis {axis + 1}")
             )
         here = np.array([r[i] for _, r, _ in bodies]) * scale
         out.append(
