@@ -2,16 +2,19 @@
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_robots.py [--repeat N]
 
-Three measurements, each side by side in the same run:
+Three measurements, each side by side in the same run, for gmuk's solve strategies ``SOLVERS``
+(the tree solve, :mod:`gmuk.engine.tree`, and the dense fused one it replaces on trees):
 
 1. one ``robot.system.accelerations(state)`` call against one ``pin.aba`` call (C++, through
    its Python binding) on the Panda (fingers locked), Solo12 (floating base) and UR5: medians
    and ratios;
 2. a 1 s Panda run from a random state at rtol = atol = 1e-10: gmuk's ``simulate`` against
    Pinocchio's ABA driven by scipy's DOP853 at the same tolerances, with each one's error
-   against a reference at 1e-13 (Pinocchio + DOP853);
-3. the cost of one accelerations call on a chain of n revolute links, n = 5 … 160, and the
-   exponent of its growth (a least-squares fit of log time against log n).
+   against a reference at 1e-13 (Pinocchio + DOP853), and the time per evaluation;
+3. the cost of one accelerations call, and of one evaluation inside the compiled loop (a
+   short run's time over its evaluations), on a chain of n revolute links, n = 5 … 1000
+   (``--sizes``; the dense fused solve up to ``--dense-max`` links), and the exponent of its
+   growth between successive n and by a least-squares fit of log time against log n.
 """
 
 from __future__ import annotations
@@ -28,6 +31,9 @@ import gmuk
 from gmuk.robots import RevoluteJoint, Robot, example_robot_data
 
 FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
+#: gmuk's strategies side by side: the tree solve and the dense fused one (QR up to 48 rows,
+#: then the SVD), the default on these robots before the tree solve.
+SOLVERS = ("tree", "fused")
 ROBOTS = {
     "panda": ("panda_description/urdf/panda.urdf", "fixed", FINGERS),
     "solo12": ("solo_description/robots/solo12.urdf", "floating", ()),
@@ -48,27 +54,35 @@ def _median_s(fn, repeat: int, inner: int) -> float:
 def one_call(repeat: int) -> None:
     print("one accelerations call against pin.aba (medians)")
     for name, (path, base, locked) in ROBOTS.items():
-        robot = Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked)
-        model, data = robot.model, robot.model.createData()
-        rng = np.random.default_rng(0)
-        pin.seed(0)  # Pinocchio's own generator: the same states in every run
-        q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
-        v, tau = rng.normal(size=model.nv), np.zeros(model.nv)
-        state = robot.state(q, v)
-        robot.system.accelerations(state)
-        t_g = _median_s(lambda r=robot, s=state: r.system.accelerations(s), repeat, 50)
-        t_p = _median_s(
-            lambda m=model, d=data, q=q, v=v, u=tau: pin.aba(m, d, q, v, u), repeat, 2000
-        )
-        rows = sum(j._T.shape[0] for j in robot.joints.values())
-        print(f"  {name:7s} nv={model.nv:2d} rows={rows:3d}: gmuk {t_g * 1e6:8.1f} µs, "
-              f"pin.aba {t_p * 1e6:6.2f} µs, ratio {t_g / t_p:7.1f}")  # fmt: skip
+        for solver in SOLVERS:
+            robot = Robot.from_urdf(
+                example_robot_data(path), base=base, locked_joints=locked, solver=solver
+            )
+            model, data = robot.model, robot.model.createData()
+            rng = np.random.default_rng(0)
+            pin.seed(0)  # Pinocchio's own generator: the same states in every run
+            q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+            v, tau = rng.normal(size=model.nv), np.zeros(model.nv)
+            state = robot.state(q, v)
+            robot.system.accelerations(state)
+            t_g = _median_s(lambda r=robot, s=state: r.system.accelerations(s), repeat, 50)
+            t_p = _median_s(
+                lambda m=model, d=data, q=q, v=v, u=tau: pin.aba(m, d, q, v, u), repeat, 2000
+            )
+            rows = sum(j._T.shape[0] for j in robot.joints.values())
+            print(f"  {name:7s} nv={model.nv:2d} rows={rows:3d} {solver:5s}: gmuk "
+                  f"{t_g * 1e6:8.1f} µs, pin.aba {t_p * 1e6:6.2f} µs, "
+                  f"ratio {t_g / t_p:7.1f}")  # fmt: skip
 
 
 def panda_run(repeat: int) -> None:
     path, _, locked = ROBOTS["panda"]
-    robot = Robot.from_urdf(example_robot_data(path), locked_joints=locked)
-    model, data = robot.model, robot.model.createData()
+    robots = {
+        s: Robot.from_urdf(example_robot_data(path), locked_joints=locked, solver=s)
+        for s in SOLVERS
+    }
+    model = robots[SOLVERS[0]].model
+    data = model.createData()
     rng = np.random.default_rng(12)
     pin.seed(12)
     q0 = pin.randomConfiguration(model, -2.0 * np.ones(7), 2.0 * np.ones(7))
@@ -83,29 +97,39 @@ def panda_run(repeat: int) -> None:
                          rtol=tol, atol=tol)  # fmt: skip
 
     ref = pin_run(1e-13).y[:7].T
-    state = robot.state(q0, v0)
-    robot.system.simulate(state, (0.0, 1.0), t_eval=t)
     out = {}
+    runs = {}
+    for solver, robot in robots.items():
+        state = robot.state(q0, v0)
+        robot.system.simulate(state, (0.0, 1.0), t_eval=t)  # the loop compiled or loaded
 
-    def gmuk_run():
-        out["traj"] = robot.system.simulate(state, (0.0, 1.0), t_eval=t, rtol=1e-10, atol=1e-10)
+        def gmuk_run(r=robot, s=state, key=solver):
+            out[key] = r.system.simulate(s, (0.0, 1.0), t_eval=t, rtol=1e-10, atol=1e-10)
+
+        runs[solver] = gmuk_run
 
     def pinocchio_run():
         out["pin"] = pin_run(1e-10)
 
-    t_g = _median_s(gmuk_run, repeat, 1)
-    t_p = _median_s(pinocchio_run, repeat, 1)
-    e_g = np.abs(robot.configuration(out["traj"]) - ref).max()
+    times = {key: [] for key in (*SOLVERS, "pin")}
+    for _ in range(repeat):  # each round times every contender in turn: the same load
+        for key, fn in (*runs.items(), ("pin", pinocchio_run)):
+            times[key].append(_median_s(fn, 1, 1))
+    t_p = statistics.median(times["pin"])
     e_p = np.abs(out["pin"].y[:7].T - ref).max()
     print("1 s Panda run, rtol = atol = 1e-10 (medians)")
-    print(
-        f"  gmuk      {t_g:7.3f} s, error {e_g:.1e} rad, {out['traj'].stats['n_rhs']} evaluations"
-    )
-    print(f"  pin+DOP853 {t_p:6.3f} s, error {e_p:.1e} rad, {out['pin'].nfev} evaluations")
-    print(f"  ratio gmuk / Pinocchio {t_g / t_p:.2f}")
+    for solver, robot in robots.items():
+        t_g = statistics.median(times[solver])
+        e_g = np.abs(robot.configuration(out[solver]) - ref).max()
+        n = out[solver].stats["n_rhs"]
+        print(f"  gmuk {solver:5s} {t_g:7.3f} s, error {e_g:.1e} rad, {n} evaluations "
+              f"({t_g / n * 1e6:.1f} µs each), ratio gmuk / Pinocchio {t_g / t_p:.2f}")  # fmt: skip
+    n_p = out["pin"].nfev
+    print(f"  pin+DOP853 {t_p:6.3f} s, error {e_p:.1e} rad, {n_p} evaluations "
+          f"({t_p / n_p * 1e6:.1f} µs each)")  # fmt: skip
 
 
-def chain(n: int) -> tuple[gmuk.System, gmuk.State]:
+def chain(n: int, solver: str | None = None) -> tuple[gmuk.System, gmuk.State]:
     links = [gmuk.RigidBody(f"l{i}", 1.0, np.diag([0.01, 0.09, 0.09])) for i in range(n)]
     half = np.eye(4)
     half[0, 3] = 0.15
@@ -114,7 +138,7 @@ def chain(n: int) -> tuple[gmuk.System, gmuk.State]:
         RevoluteJoint(links[i - 1], links[i], parent_frame=half, child_frame=np.linalg.inv(half))
         for i in range(1, n)
     ]
-    system = gmuk.System(links, joints, [gmuk.UniformGravity((0.0, -9.81, 0.0))])
+    system = gmuk.System(links, joints, [gmuk.UniformGravity((0.0, -9.81, 0.0))], solver=solver)
     g, V = {}, {}
     for i, body in enumerate(links):
         pose = np.eye(4)
@@ -123,28 +147,66 @@ def chain(n: int) -> tuple[gmuk.System, gmuk.State]:
     return system, system.state(g=g, V=V)
 
 
-def scaling(repeat: int, sizes: tuple[int, ...]) -> None:
-    print("one accelerations call on a chain of n revolute links (medians)")
-    times = []
-    for n in sizes:
-        system, state = chain(n)
-        system.accelerations(state)
-        t_g = _median_s(lambda y=system, s=state: y.accelerations(s), max(3, repeat // 2), 5)
-        times.append(t_g)
-        print(f"  n = {n:4d}: {t_g * 1e3:9.3f} ms  ({type(system.solver).__name__})")
-    for k in range(1, len(sizes)):
-        slope = np.log(times[k] / times[k - 1]) / np.log(sizes[k] / sizes[k - 1])
-        print(f"  exponent from n = {sizes[k - 1]} to {sizes[k]}: {slope:.2f}")
+def _loop_evaluation_s(system: gmuk.System, state: gmuk.State, repeat: int) -> float:
+    """The time of one evaluation inside the compiled loop: a short run (0.01 s of the chain
+    falling from rest, outputs at its ends only) over its number of evaluations (medians)."""
+    per = []
+    for _ in range(max(1, repeat)):
+        t0 = time.perf_counter()
+        traj = system.simulate(state, (0.0, 0.01), t_eval=[0.0, 0.01])
+        per.append((time.perf_counter() - t0) / traj.stats["n_rhs"])
+    return statistics.median(per)
+
+
+def scaling(repeat: int, sizes: tuple[int, ...], dense_max: int) -> None:
+    print("a chain of n revolute links: one accelerations call, one loop evaluation (medians)")
+    fits = {}
+    for solver in SOLVERS:
+        times, loop_times, ns = [], [], []
+        for n in sizes:
+            if solver != "tree" and n > dense_max:
+                continue
+            system, state = chain(n, solver)
+            system.accelerations(state)
+            system.simulate(state, (0.0, 0.001))  # the loop compiled or loaded
+            inner = max(1, 200 // n)
+            t_g = _median_s(
+                lambda y=system, s=state: y.accelerations(s), max(3, repeat // 2), inner
+            )
+            t_l = _loop_evaluation_s(system, state, max(3, repeat // 2))
+            times.append(t_g)
+            loop_times.append(t_l)
+            ns.append(n)
+            print(f"  {solver:5s} n = {n:4d}: call {t_g * 1e3:9.3f} ms, loop evaluation "
+                  f"{t_l * 1e3:9.3f} ms  ({type(system.solver).__name__})")  # fmt: skip
+        for k in range(1, len(ns)):
+            slope = np.log(times[k] / times[k - 1]) / np.log(ns[k] / ns[k - 1])
+            slope_l = np.log(loop_times[k] / loop_times[k - 1]) / np.log(ns[k] / ns[k - 1])
+            print(f"  {solver:5s} exponent from n = {ns[k - 1]} to {ns[k]}: call {slope:.2f}, "
+                  f"loop {slope_l:.2f}")  # fmt: skip
+        if len(ns) > 1:
+            fits[solver] = (
+                np.polyfit(np.log(ns), np.log(times), 1)[0],
+                np.polyfit(np.log(ns), np.log(loop_times), 1)[0],
+            )
+    for solver, (call, loop) in fits.items():
+        print(f"  {solver:5s} least-squares exponent over all n: call {call:.2f}, loop {loop:.2f}")
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
-    parser.add_argument("--sizes", default="5,10,20,40,80,160")
+    parser.add_argument("--sizes", default="5,10,20,40,80,160,320,640,1000")
+    parser.add_argument("--dense-max", type=int, default=40)
+    parser.add_argument("--only", default="call,run,chain", help="which measurements")
     args = parser.parse_args(argv)
-    one_call(args.repeat)
-    panda_run(args.repeat)
-    scaling(args.repeat, tuple(int(s) for s in args.sizes.split(",")))
+    only = set(args.only.split(","))
+    if "call" in only:
+        one_call(args.repeat)
+    if "run" in only:
+        panda_run(args.repeat)
+    if "chain" in only:
+        scaling(args.repeat, tuple(int(s) for s in args.sizes.split(",")), args.dense_max)
 
 
 if __name__ == "__main__":

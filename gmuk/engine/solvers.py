@@ -20,6 +20,11 @@ Built in (names for ``System(..., solver=NAME)``):
 ``"sparse"`` (:class:`SparseSolver`)
     Sparse rows; A M⁻¹ Aᵀ λ = r by SuperLU or conjugate gradients
     (:func:`gmuk.engine.uk.solve_sparse`).
+``"tree"`` (:class:`gmuk.engine.tree.TreeSolver`)
+    Constraints on one or two rigid bodies forming a tree or forest with the ground (a
+    robot's joints): the block LDLᵀ factorisation of the KKT system with no fill-in (Baraff
+    1996), linear in the number of bodies; compiled, with the dense or sparse solve where it
+    cannot certify full row rank.
 ``"eq80"`` (:class:`TangentBundleEq80Solver`)
     McCann (2020) Eq. 80 as printed for one :class:`~gmuk.constraints.TangentBundleConstraint`,
     with each body's block of g̈_c projected onto g·se(3).
@@ -230,6 +235,12 @@ class UKSolver(abc.ABC):
     def problems(cls, system: System) -> list[str]:
         """What this strategy cannot solve in ``system`` (empty if it can)."""
         return []
+
+    @classmethod
+    def wants_sparse(cls, system: System) -> bool:
+        """Whether the System being built should keep sparse rows and mass blocks for this
+        strategy (``sparse`` unless a strategy decides by the System's size)."""
+        return cls.sparse
 
     def accelerations(self, state: State) -> Accelerations:
         """Free, constraint and total accelerations at ``state`` (the System has checked
@@ -576,3 +587,7 @@ def resolve(solver: object) -> type[UKSolver]:
         f"solver must be one of {sorted(SOLVERS)} or a gmuk.engine.solvers.UKSolver subclass; "
         f"got {solver!r}"
     )
+
+
+# The tree solve registers itself as "tree" (its module imports this one).
+from gmuk.engine import tree as _tree  # noqa: E402, F401

@@ -41,6 +41,7 @@ from gmuk.engine.events import Event
 from gmuk.engine.integrate import simulate as _simulate
 from gmuk.engine.integrators import _program
 from gmuk.engine.solvers import QR_COND_LIMIT, QR_MAX_ROWS, Accelerations, UKSolver
+from gmuk.engine.tree import TREE, TreeSolver
 from gmuk.errors import ConstraintError, DefinitionError, GmukError, NonFiniteError
 from gmuk.forces.base import ForceModel
 from gmuk.state import Layout, State
@@ -214,7 +215,7 @@ class System:
         self._zero_loads.setflags(write=False)
         self._zero_z = self._zero_loads[:0]
         solver_cls = self._choose_solver(solver, sparse)
-        self.sparse = solver_cls.sparse
+        self.sparse = solver_cls.wants_sparse(self)
         self._build_mass()
         self._build_index()
         self.solver: UKSolver = solver_cls(self)
@@ -825,8 +826,8 @@ class System:
         and the Python callback the compiled loop runs (:mod:`gmuk.engine.integrators._program`).
 
         Each part contributes what it declares (its ``_compiled_term``; parts without one are
-        called back in Python), and the solve runs compiled under the ``"fused"`` and
-        ``"dense"`` strategies, in Python otherwise (:attr:`compiled_solve`). The row counts
+        called back in Python), and the solve runs compiled under the ``"fused"``, ``"dense"``
+        and ``"tree"`` strategies, in Python otherwise (:attr:`compiled_solve`). The row counts
         of constraints evaluated in Python are read at ``state``.
 
         Raises
@@ -841,6 +842,8 @@ class System:
             constants = np.array(self.solver._params)  # type: ignore[attr-defined]
         elif solve == _program.DENSE:
             constants = self._Minv_sqrt
+        elif solve == TREE:  # the packed tree after its first two entries (build() adds them)
+            constants = self.solver.loop_constants(state)  # type: ignore[attr-defined]
         else:
             constants = np.zeros(1)
         view = _program.SystemView(
@@ -877,7 +880,8 @@ class System:
     @property
     def compiled_solve(self) -> tuple[int, str]:
         """How the compiled loop solves this System (``gmuk.engine.integrators._program``'s FREE,
-        FUSED, DENSE or PYTHON_SOLVE) and, for PYTHON_SOLVE, why."""
+        FUSED, DENSE or PYTHON_SOLVE, or :data:`gmuk.engine.tree.TREE`) and, for PYTHON_SOLVE,
+        why."""
         if type(self).accelerations is not System.accelerations:
             return _program.PYTHON_SOLVE, "the System subclass has its own accelerations"
         if not self.constraints:
@@ -886,6 +890,8 @@ class System:
             return _program.FUSED, ""
         if type(self.solver) is solvers.DenseSolver:
             return _program.DENSE, ""
+        if type(self.solver) is TreeSolver:
+            return TREE, ""
         return _program.PYTHON_SOLVE, f"the constraints are solved by {type(self.solver).__name__}"
 
     # ------------------------------------------------------------------ simulation

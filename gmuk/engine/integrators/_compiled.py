@@ -6,8 +6,10 @@ gravity, uniform-gravity and linear spring–damper models (``ForceModel._compil
 unless a subclass overrides their methods), LVLH configuration tracking and relative
 constraints on rigid bodies, the corrected Morse–Lyapunov law on an LVLH reference
 (``Controller._compiled_term``), the free acceleration and the Udwadia–Kalaba solve of the
-``"fused"`` and ``"dense"`` strategies. Everything else is called back in Python from inside
-the loop through a C function (:class:`PythonParts`), and costs only its own Python:
+``"fused"``, ``"dense"`` and ``"tree"`` strategies (the tree solve's rows in blocks of each
+constraint's one or two bodies, :func:`_constraint_blocks`). Everything else is called back
+in Python from inside the loop through a C function (:class:`PythonParts`), and costs only
+its own Python:
 
 * force models, constraints and controllers without a compiled form (phases
   :data:`PHASE_LOADS` and :data:`PHASE_CONTROLS`);
@@ -66,6 +68,7 @@ from gmuk.engine.integrators._program import (
     Program,
     reference_records,
 )
+from gmuk.engine.tree import TREE, tree_pair, tree_solve
 from gmuk.forces.base import FORCE_KERNEL
 from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
 
@@ -270,10 +273,16 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
                 modeled[i] += io[lo + i]
                 unmodeled[i] += io[lo + ndof + i]
         rank_at = 5 * ndof + s + 1 + nc
-        if s:  # the stacked rows, for the fused or the dense solve
-            A = np.zeros((s, ndof))
-            b = np.empty(s)
-            status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
+        if s:  # the stacked rows: (s, n_dof) for the fused or the dense solve, blocks (s, 12)
+            b = np.empty(s)  # on each constraint's one or two bodies for the tree solve
+            if d.solve == TREE:
+                A = np.zeros((s, 12))
+                status = _constraint_blocks(
+                    t, g, V, parts.cons, parts.cparams, io, r_off, parts.uk_params, A, b
+                )
+            else:
+                A = np.zeros((s, ndof))
+                status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
             if status != 0:
                 ints[I_FIELD] = status
                 _write_state(t, g, V, Y, d, io)
@@ -311,13 +320,19 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
             for i in range(2 * ndof, 4 * ndof + s + 1):
                 aux[i] = 0.0
             aux[rank_at] = d.free_rank
-            if s:  # the dense strategy's certified QR solve (DenseSolver.solve_rows)
+            if s:  # the dense strategy's certified QR solve (DenseSolver.solve_rows), or
+                # the tree strategy's certified block LDLᵀ (TreeSolver.solve)
                 ac = aux[2 * ndof : 3 * ndof]
                 P = parts.uk_params
-                Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
-                residual, scale, status = _qr_solve(
-                    A, b, total, Minv_sqrt, P[0], ac, aux[4 * ndof : 4 * ndof + s]
-                )
+                if d.solve == TREE:
+                    residual, scale, status = tree_solve(
+                        total, A, b, P, ac, aux[4 * ndof : 4 * ndof + s]
+                    )
+                else:
+                    Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
+                    residual, scale, status = _qr_solve(
+                        A, b, total, Minv_sqrt, P[0], ac, aux[4 * ndof : 4 * ndof + s]
+                    )
                 if status != 0 or residual > P[1] * scale:  # the Python solve decides
                     if not written:
                         _write_state(t, g, V, Y, d, io)
@@ -449,6 +464,47 @@ def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[n
             if j >= 0:
                 for e in range(6):
                     A[r0 + a, r_off[j] + e] = Ak[a, 6 + e]
+    return 0
+
+
+@_helper
+def _constraint_blocks(t, g, V, cons, cparams, io, r_off, P, A, b):  # type: ignore[no-untyped-def]
+    """The rows of the tree solve (:func:`gmuk.engine.tree.tree_solve`): each constraint's
+    rows on its first body (columns 0–5 of A (s, 12)) and its second (6–11), computed by its
+    kernel or copied from the dense rows PythonParts wrote into ``io`` (the bodies from the
+    packed tree ``P``). Returns 0 or the status of a failed kernel."""
+    ndof = 6 * r_off.shape[0]  # rigid bodies only
+    for c in range(cons.shape[0]):
+        kind, i, j, r0, nrow, p0 = (
+            cons[c, 0],
+            cons[c, 1],
+            cons[c, 2],
+            cons[c, 3],
+            cons[c, 4],
+            cons[c, 5],
+        )
+        if kind == PYTHON:  # A (nrow, n_dof) then b (nrow) at io[p0:]
+            ia, ib = tree_pair(P, c)
+            for a in range(nrow):
+                for e in range(6):
+                    A[r0 + a, e] = io[p0 + a * ndof + r_off[ia] + e]
+                    if ib >= 0:
+                        A[r0 + a, 6 + e] = io[p0 + a * ndof + r_off[ib] + e]
+                b[r0 + a] = io[p0 + nrow * ndof + a]
+            continue
+        Ak = np.empty((nrow, 12))
+        bk = np.empty(nrow)
+        second = j if j >= 0 else i
+        status = _call_rows(kind, (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
+        if status != 0:
+            return status
+        for a in range(nrow):
+            b[r0 + a] = bk[a]
+            for e in range(6):
+                A[r0 + a, e] = Ak[a, e]
+            if j >= 0:
+                for e in range(6):
+                    A[r0 + a, 6 + e] = Ak[a, 6 + e]
     return 0
 
 

@@ -1,0 +1,847 @@
+"""Linear-time Udwadia–Kalaba solve for tree-structured constraints (Baraff 1996).
+
+When every constraint couples at most two rigid bodies and the constraints form a tree (or a
+forest) with the ground, the constrained equations
+
+``[[M, Aᵀ], [A, 0]] [ν̇_c; μ] = [0; b − A ν̇_a]``,   λ = −μ,
+
+have the sparsity of that tree: order the unknowns as nodes, one per body (its 6 × 6 block
+M_i = blkdiag(J_i, m_i I)) and one per constraint (its s_k × s_k zero block), coupled by the
+constraint's rows on each of its bodies (A_k's s_k × 6 block on body i). Root each tree of the
+forest at a joint to the ground (or, for a tree that never reaches the ground, a floating
+base, at its first body) and eliminate leaves first: the block LDLᵀ factorisation then has
+no fill-in (Baraff 1996, Sections 3–5), and the whole solve costs O(number of bodies).
+
+With the unknowns of node i written x_i and its parent p (the node next to it on the way to
+the root), elimination in leaves-first order is
+
+``D_i = H_ii − Σ_{c child of i} H_ic D_c⁻¹ H_ci``,  ``X_i = D_i⁻¹ H_ip``,
+
+then ``y_i = r_i − Σ_c X_cᵀ y_c``, ``z_i = D_i⁻¹ y_i`` and, from the roots outwards,
+``x_i = z_i − X_i x_p``. A body's D_i is its mass matrix plus the positive-semidefinite
+reflection of its subtree (positive definite); a constraint's D_k is minus
+``A_k,c D_c⁻¹ A_k,cᵀ`` for its child body c (negative definite exactly when the rows on its
+child have full row rank). Each D is factorised by Cholesky (of −D_k for a constraint); a
+pivot below :data:`PIVOT_TOL` times the block's largest diagonal entry means the rows are
+not certified to have full row rank, and the solve falls back to the dense
+(QR, else SVD) or the sparse strategy, which decide the rank and the minimum-norm solution.
+This is the maximal-coordinate counterpart of Featherstone's articulated-body algorithm.
+
+The multipliers are the Udwadia–Kalaba ones (``λ = (A M⁻¹ Aᵀ)⁻¹ (b − A ν̇_a)``, Eq. 3 of
+McCann 2020), the constraint acceleration ``ν̇_c = M⁻¹ Aᵀ λ`` (Eq. 64): for full row rank A
+the KKT solution is unique and equals the Moore–Penrose one of the dense solve.
+
+References
+----------
+Baraff, D. (1996). Linear-time dynamics using Lagrange multipliers. *Proceedings of
+SIGGRAPH 96*, 137–146.
+McCann, B. (2020), Eqs. 3 and 64.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import TYPE_CHECKING, Any, NamedTuple
+
+import numpy as np
+from numba import types
+
+from gmuk._numba import kernel_address, kernel_caller, njit
+from gmuk._validation import FloatArray, all_finite
+from gmuk.bodies import BodyKind
+from gmuk.constraints.base import ROWS_KERNEL, as_rows
+from gmuk.dynamics import rigid_free_accel
+from gmuk.engine import _uk_kernels, uk
+from gmuk.engine._uk_kernels import consistency_scale
+from gmuk.engine.solvers import (
+    _EPS,
+    _F64,
+    _NO_MULTIPLIERS,
+    QR_COND_LIMIT,
+    QR_MAX_ROWS,
+    Accelerations,
+    Solution,
+    SolveStatus,
+    UKSolver,
+    _writable,
+)
+from gmuk.errors import ConstraintError
+
+if TYPE_CHECKING:
+    from gmuk.engine.system import System
+    from gmuk.state import State
+
+__all__ = [
+    "PIVOT_TOL",
+    "TREE",
+    "TREE_SIGNATURE",
+    "TreeSolver",
+    "tree_pair",
+    "tree_params",
+    "tree_rigid",
+    "tree_solve",
+    "tree_structure",
+]
+
+#: A Cholesky pivot of a node's block at or below PIVOT_TOL times the block's largest
+#: diagonal entry is not certified: the rows may not have full row rank there, and the
+#: solve falls back to the dense or sparse strategy.
+PIVOT_TOL = 1e-12
+#: Rows of one constraint in a tree solve: at most one body's six freedoms.
+MAX_NODE_ROWS = 6
+#: Up to this many dof the System keeps dense rows and mass matrix under the tree solve, and
+#: a call the tree solve cannot certify takes the dense solve (QR, else SVD) of
+#: :class:`~gmuk.engine.solvers.DenseSolver`; above it sparse ones, and the sparse solve
+#: (the System's ``SPARSE_THRESHOLD``).
+DENSE_FALLBACK_DOF = 300
+
+_RW1 = types.Array(types.float64, 1, "C")
+_RW2 = types.Array(types.float64, 2, "C")
+#: The signature of :func:`tree_rigid` (writable C-contiguous float64 arrays): the System's
+#: tree solve calls that overload's compiled function without numba's dispatcher.
+TREE_SIGNATURE = types.void(_RW2, _RW1, _RW2, _RW1, _RW1, _RW1)
+_tree_rigid_c: Any = None
+
+_SOLVED = float(SolveStatus.SOLVED)
+_NOT_FINITE = float(SolveStatus.NOT_FINITE)
+
+#: How the compiled loop solves a System of the tree strategy (``Dims.solve``), beside
+#: :mod:`gmuk.engine.integrators._program`'s FREE, FUSED, DENSE and PYTHON_SOLVE (0–3).
+TREE = 4
+
+# Layout of the packed parameters P (float64): [unused, consistency_tol, n_b, n_c,
+# J (9 n_b), J⁻¹ (9 n_b), m (n_b), order (n_b + n_c), parent (n_b + n_c), body_a (n_c),
+# body_b (n_c), rows (n_c)]. Nodes 0 … n_b − 1 are the bodies, n_b + k constraint k.
+_HEAD = 4
+
+
+# ----------------------------------------------------------------------------- structure
+def tree_structure(
+    n_bodies: int, pairs: list[tuple[int, int]]
+) -> tuple[np.ndarray, np.ndarray] | str:
+    """The elimination order and parents of the body–constraint tree, or why there is none.
+
+    Parameters
+    ----------
+    n_bodies : int
+        Rigid bodies 0 … n_bodies − 1.
+    pairs : list of (int, int)
+        Each constraint's bodies (a, b), b = −1 for a constraint on one body (to the ground).
+
+    Returns
+    -------
+    (order, parent) : int64 arrays (n_bodies + n_c,)
+        Nodes leaves first (children before their parent) and each node's parent (−1 for a
+        root); nodes 0 … n_bodies − 1 are the bodies, n_bodies + k constraint k. Each tree
+        that reaches the ground is rooted at its constraint to the ground, any other at its
+        first body.
+    str
+        When the constraints with the ground do not form a forest: what closes a loop.
+    """
+    nb, nc = n_bodies, len(pairs)
+    nn = nb + nc
+    # the bipartite graph of bodies and constraints; the ground is node nn
+    adj: list[list[int]] = [[] for _ in range(nn + 1)]
+    for k, (a, b) in enumerate(pairs):
+        node = nb + k
+        for body in (a, b):
+            other = nn if body < 0 else body
+            adj[node].append(other)
+            adj[other].append(node)
+    parent = np.full(nn + 1, -2, dtype=np.int64)  # −2: not reached yet
+    bfs: list[int] = []
+    roots = [nn, *range(nb)]  # the ground first, then each body not reached
+    for root in roots:
+        if parent[root] != -2:
+            continue
+        parent[root] = -1
+        queue = deque([root])
+        while queue:
+            i = queue.popleft()
+            bfs.append(i)
+            for j in adj[i]:
+                if j == parent[i]:
+                    continue
+                if parent[j] != -2:
+                    what = "the ground" if j == nn or i == nn else "a body"
+                    return (
+                        "the constraints close a loop (through "
+                        f"{what}): a tree solve needs a tree or forest of bodies and "
+                        "constraints, each constraint on one body (to the ground) or two"
+                    )
+                parent[j] = i
+                queue.append(j)
+    order = np.array([i for i in reversed(bfs) if i != nn], dtype=np.int64)
+    par = parent[:nn].copy()
+    par[par == nn] = -1  # the ground's children (its constraints) are roots
+    return order, par
+
+
+def tree_params(
+    J: FloatArray,
+    Jinv: FloatArray,
+    m: FloatArray,
+    order: np.ndarray,
+    parent: np.ndarray,
+    pairs: list[tuple[int, int]],
+    rows: list[int],
+    consistency_tol: float,
+) -> np.ndarray:
+    """The constant arguments of :func:`tree_solve` and :func:`tree_rigid` in one writable
+    float64 vector (see ``_HEAD``): the bodies' central inertias J (n_b, 3, 3) (kg·m²),
+    their inverses, masses m (n_b,) (kg), the tree (:func:`tree_structure`), each
+    constraint's bodies and row count."""
+    nb, nc = m.shape[0], len(pairs)
+    return np.concatenate(
+        [
+            [0.0, float(consistency_tol), float(nb), float(nc)],
+            np.ravel(J),
+            np.ravel(Jinv),
+            np.ravel(m),
+            np.asarray(order, dtype=float),
+            np.asarray(parent, dtype=float),
+            [float(a) for a, _ in pairs],
+            [float(b) for _, b in pairs],
+            np.asarray(rows, dtype=float),
+        ]
+    ).astype(np.float64)
+
+
+# ----------------------------------------------------------------------------- kernels
+@njit(cache=True, inline="always")
+def tree_pair(P: np.ndarray, k: int) -> tuple[int, int]:
+    """Constraint k's bodies (a, b) in the packed parameters P (b = −1: to the ground)."""
+    nb = int(P[2])
+    nc = int(P[3])
+    o = _HEAD + 19 * nb + 2 * (nb + nc)
+    return int(P[o + k]), int(P[o + nc + k])
+
+
+@njit(cache=True, inline="always")
+def _cholesky(D: np.ndarray, d: int, sign: float, C: np.ndarray) -> bool:
+    """C (lower) with C Cᵀ = sign · D[:d, :d]; False when a pivot is not above PIVOT_TOL
+    times the largest diagonal entry (or not finite)."""
+    big = 0.0
+    for i in range(d):
+        big = max(big, sign * D[i, i])
+    if not big > 0.0:
+        return d == 0
+    tol = PIVOT_TOL * big
+    for j in range(d):
+        acc = sign * D[j, j]
+        for k in range(j):
+            acc -= C[j, k] * C[j, k]
+        if not acc > tol:
+            return False
+        cjj = np.sqrt(acc)
+        C[j, j] = cjj
+        for i in range(j + 1, d):
+            acc = sign * D[i, j]
+            for k in range(j):
+                acc -= C[i, k] * C[j, k]
+            C[i, j] = acc / cjj
+    return True
+
+
+@njit(cache=True, inline="always")
+def _chol_solve(C: np.ndarray, d: int, sign: float, y: np.ndarray) -> None:
+    """y ← D⁻¹ y in place for D = sign · C Cᵀ (d × d)."""
+    for i in range(d):
+        acc = y[i]
+        for k in range(i):
+            acc -= C[i, k] * y[k]
+        y[i] = acc / C[i, i]
+    for i in range(d - 1, -1, -1):
+        acc = y[i]
+        for k in range(i + 1, d):
+            acc -= C[k, i] * y[k]
+        y[i] = acc / C[i, i]
+    if sign < 0.0:
+        for i in range(d):
+            y[i] = -y[i]
+
+
+@njit(cache=True)
+def tree_solve(
+    a: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, ac: np.ndarray, lam: np.ndarray
+) -> tuple[float, float, int]:
+    """The UK solve of tree-structured rows by block LDLᵀ with no fill-in (module docstring).
+
+    Parameters
+    ----------
+    a : ndarray (6 n_b,)
+        ν̇_a, the free accelerations [ω̇; v̇] of the bodies (rad/s², m/s²).
+    A : ndarray (s, 12)
+        Each constraint's rows on its first body (columns 0–5) and its second (6–11, zero
+        for a constraint to the ground), stacked in constraint order.
+    b : ndarray (s,)
+    P : ndarray
+        From :func:`tree_params`.
+    ac, lam : ndarray (6 n_b,), (s,)
+        Written: ν̇_c and λ.
+
+    Returns
+    -------
+    (‖A(a + ν̇_c) − b‖₂, scale of the consistency test, status): status 0 solved, 1 not
+    certified (a pivot, or a constraint with more than six rows), 2 A or b not finite.
+    """
+    nb = int(P[2])
+    nc = int(P[3])
+    nn = nb + nc
+    s = b.shape[0]
+    for i in range(s):
+        if not np.isfinite(b[i]):
+            return np.nan, np.nan, 2
+        for e in range(12):
+            if not np.isfinite(A[i, e]):
+                return np.nan, np.nan, 2
+    o = _HEAD
+    J = P[o : o + 9 * nb].reshape((nb, 3, 3))
+    o += 18 * nb  # J, J⁻¹
+    m = P[o : o + nb]
+    o += nb
+    order = P[o : o + nn]
+    o += nn
+    parent = P[o : o + nn]
+    o += nn
+    body_a = P[o : o + nc]
+    body_b = P[o + nc : o + 2 * nc]
+    nrow = P[o + 2 * nc : o + 3 * nc]
+    row0 = np.empty(nc, dtype=np.int64)
+    dim = np.empty(nn, dtype=np.int64)
+    r = 0
+    for k in range(nc):
+        row0[k] = r
+        dk = int(nrow[k])
+        if dk > 6:
+            return np.nan, np.nan, 1
+        dim[nb + k] = dk
+        r += dk
+    if r != s:
+        return np.nan, np.nan, 1
+    for i in range(nb):
+        dim[i] = 6
+    D = np.zeros((nn, 6, 6))
+    C = np.zeros((nn, 6, 6))
+    X = np.zeros((nn, 6, 6))
+    y = np.zeros((nn, 6))
+    for i in range(nb):  # D_i = M_i = blkdiag(J_i, m_i I)
+        for u in range(3):
+            for v in range(3):
+                D[i, u, v] = J[i, u, v]
+            D[i, 3 + u, 3 + u] = m[i]
+    for k in range(nc):  # the joint nodes' right-hand side r_k = b_k − A_k a
+        ia = int(body_a[k])
+        ib = int(body_b[k])
+        for u in range(int(nrow[k])):
+            row = row0[k] + u
+            acc = b[row]
+            for e in range(6):
+                acc -= A[row, e] * a[6 * ia + e]
+                if ib >= 0:
+                    acc -= A[row, 6 + e] * a[6 * ib + e]
+            y[nb + k, u] = acc
+    H = np.empty((6, 6))  # H_ip (d_i × d_p)
+    col = np.empty(6)
+    w = np.empty(6)
+    for step in range(nn):
+        i = int(order[step])
+        di = dim[i]
+        sign = 1.0 if i < nb else -1.0
+        if not _cholesky(D[i], di, sign, C[i]):
+            return np.nan, np.nan, 1
+        p = int(parent[i])
+        # z_i = D_i⁻¹ y_i (y_i is final: every child has been subtracted)
+        for u in range(di):
+            col[u] = y[i, u]
+        _chol_solve(C[i], di, sign, col)
+        if p >= 0:
+            dp = dim[p]
+            # H_ip: the rows of the constraint node on the body node
+            if i < nb:  # i body, p constraint k: H_ip = A_k[:, body i]ᵀ (6 × s_k)
+                k = p - nb
+                half = 0 if int(body_a[k]) == i else 6
+                for u in range(6):
+                    for v in range(dp):
+                        H[u, v] = A[row0[k] + v, half + u]
+            else:  # i constraint k, p body: H_ip = A_k[:, body p] (s_k × 6)
+                k = i - nb
+                half = 0 if int(body_a[k]) == p else 6
+                for u in range(di):
+                    for v in range(6):
+                        H[u, v] = A[row0[k] + u, half + v]
+            # X_i = D_i⁻¹ H_ip, column by column
+            for v in range(dp):
+                for u in range(di):
+                    w[u] = H[u, v]
+                _chol_solve(C[i], di, sign, w)
+                for u in range(di):
+                    X[i, u, v] = w[u]
+            # D_p −= H_ipᵀ X_i, y_p −= X_iᵀ y_i
+            for u in range(dp):
+                for v in range(dp):
+                    acc = 0.0
+                    for q in range(di):
+                        acc += H[q, u] * X[i, q, v]
+                    D[p, u, v] -= acc
+                acc = 0.0
+                for q in range(di):
+                    acc += X[i, q, u] * y[i, q]
+                y[p, u] -= acc
+        for u in range(di):
+            y[i, u] = col[u]  # now z_i
+    # x_i = z_i − X_i x_p, roots first (y holds z, then x)
+    for step in range(nn - 1, -1, -1):
+        i = int(order[step])
+        p = int(parent[i])
+        if p >= 0:
+            di = dim[i]
+            dp = dim[p]
+            for u in range(di):
+                acc = 0.0
+                for v in range(dp):
+                    acc += X[i, u, v] * y[p, v]
+                y[i, u] -= acc
+    for i in range(nb):
+        for e in range(6):
+            ac[6 * i + e] = y[i, e]
+    for k in range(nc):
+        for u in range(int(nrow[k])):
+            lam[row0[k] + u] = -y[nb + k, u]
+    # the residual ‖A(a + ν̇_c) − b‖₂ and the scale of the consistency test
+    rr = 0.0
+    nA = 0.0
+    nbb = 0.0
+    for k in range(nc):
+        ia = int(body_a[k])
+        ib = int(body_b[k])
+        for u in range(int(nrow[k])):
+            row = row0[k] + u
+            acc = -b[row]
+            for e in range(6):
+                acc += A[row, e] * (a[6 * ia + e] + ac[6 * ia + e])
+                nA += A[row, e] * A[row, e]
+                if ib >= 0:
+                    acc += A[row, 6 + e] * (a[6 * ib + e] + ac[6 * ib + e])
+                    nA += A[row, 6 + e] * A[row, 6 + e]
+            rr += acc * acc
+            nbb += b[row] * b[row]
+    na = 0.0
+    nac = 0.0
+    for e in range(6 * nb):
+        na += a[e] * a[e]
+        nac += ac[e] * ac[e]
+    scale = consistency_scale(np.sqrt(nbb), np.sqrt(nA), np.sqrt(na), np.sqrt(nac))
+    return np.sqrt(rr), scale, 0
+
+
+@njit(cache=True)
+def tree_rigid(
+    V: np.ndarray, Q: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, out: np.ndarray
+) -> None:
+    """Free accelerations (Eq. 10b) of the twists V (n_b, 6) under the modeled wrenches Q
+    (6 n_b,), :func:`tree_solve` of the rows A (s, 12), b (s,), the constraint wrenches
+    M ν̇_c and the total, into ``out`` (4n + s + 3, n = 6 n_b): ``[a, ν̇_c, total, M ν̇_c, λ,
+    residual, scale, status]``, status 3 when solved but ``residual > consistency_tol ·
+    scale``; the other entries are meaningful only for status 0 and 3 (the layout of
+    :func:`gmuk.engine._uk_kernels.uk_rigid`)."""
+    nb = V.shape[0]
+    n = 6 * nb
+    s = b.shape[0]
+    o = _HEAD
+    J = P[o : o + 9 * nb].reshape((nb, 3, 3))
+    Jinv = P[o + 9 * nb : o + 18 * nb].reshape((nb, 3, 3))
+    m = P[o + 18 * nb : o + 19 * nb]
+    a = rigid_free_accel(V, J, Jinv, m, Q.reshape((nb, 6))).reshape(-1)
+    ac = out[n : 2 * n]
+    residual, scale, status = tree_solve(a, A, b, P, ac, out[4 * n : 4 * n + s])
+    for k in range(nb):
+        for i in range(6):
+            r = 6 * k + i
+            out[r] = a[r]
+            out[2 * n + r] = a[r] + ac[r]
+        for i in range(3):
+            o3 = 6 * k
+            out[3 * n + o3 + i] = (
+                J[k, i, 0] * ac[o3] + J[k, i, 1] * ac[o3 + 1] + J[k, i, 2] * ac[o3 + 2]
+            )
+            out[3 * n + o3 + 3 + i] = m[k] * ac[o3 + 3 + i]
+    out[4 * n + s] = residual
+    out[4 * n + s + 1] = scale
+    if status == 0 and residual > P[1] * scale:
+        status = 3
+    out[4 * n + s + 2] = status
+
+
+_call_rows = kernel_caller(ROWS_KERNEL, "constraint")
+
+
+@njit(cache=True)
+def tree_rows_rigid(
+    t: float,
+    g: np.ndarray,
+    V: np.ndarray,
+    Q: np.ndarray,
+    cons: np.ndarray,
+    cparams: np.ndarray,
+    P: np.ndarray,
+    A: np.ndarray,
+    b: np.ndarray,
+    out: np.ndarray,
+) -> int:
+    """The constraints' rows by their compiled kernels, then :func:`tree_rigid`: one call
+    for a System whose constraints all have a compiled form.
+
+    ``cons`` (n_c, 6) int64 holds each constraint's kernel address
+    (:func:`gmuk._numba.kernel_address` for :data:`gmuk.constraints.base.ROWS_KERNEL`), its
+    bodies (the second −1 for one body), first row, row count and the start of its
+    parameters in ``cparams``, as the compiled loop's constraint table does; the rows go into
+    A (s, 12) and b (s,), the results into ``out`` as :func:`tree_rigid` writes them. Returns
+    0, or the status of a constraint kernel that failed (then ``out`` is not written)."""
+    for c in range(cons.shape[0]):
+        kind, i, j, r0, nrow, p0 = (
+            cons[c, 0],
+            cons[c, 1],
+            cons[c, 2],
+            cons[c, 3],
+            cons[c, 4],
+            cons[c, 5],
+        )
+        Ak = np.empty((nrow, 12))
+        bk = np.empty(nrow)
+        second = j if j >= 0 else i
+        status = _call_rows(kind, (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
+        if status != 0:
+            return status
+        for a in range(nrow):
+            b[r0 + a] = bk[a]
+            for e in range(6):
+                A[r0 + a, e] = Ak[a, e]
+            if j >= 0:
+                for e in range(6):
+                    A[r0 + a, 6 + e] = Ak[a, 6 + e]
+    tree_rigid(V, Q, A, b, P, out)
+    return 0
+
+
+_RW3 = types.Array(types.float64, 3, "C")
+_I2 = types.Array(types.int64, 2, "C")
+#: The signature of :func:`tree_rows_rigid` as the System calls it.
+TREE_ROWS_SIGNATURE = types.int64(
+    types.float64, _RW3, _RW2, _RW1, _I2, _RW1, _RW1, _RW2, _RW1, _RW1
+)
+_tree_rows_c: Any = None
+
+
+def _tree_rows_entry() -> Any:
+    """The compiled entry of :func:`tree_rows_rigid` for :data:`TREE_ROWS_SIGNATURE`."""
+    global _tree_rows_c
+    if _tree_rows_c is None:
+        tree_rows_rigid.compile(TREE_ROWS_SIGNATURE)
+        _tree_rows_c = tree_rows_rigid.overloads[TREE_ROWS_SIGNATURE.args].entry_point
+    return _tree_rows_c
+
+
+def _tree_entry() -> Any:
+    """The compiled entry of :func:`tree_rigid` for :data:`TREE_SIGNATURE`, compiled (or
+    loaded from the cache) once."""
+    global _tree_rigid_c
+    if _tree_rigid_c is None:
+        tree_rigid.compile(TREE_SIGNATURE)
+        _tree_rigid_c = tree_rigid.overloads[TREE_SIGNATURE.args].entry_point
+    return _tree_rigid_c
+
+
+# ----------------------------------------------------------------------------- strategy
+class _Blocks(NamedTuple):
+    """Rows in blocks (A (s, 12), b (s,)) that the tree solve could not certify."""
+
+    A: FloatArray
+    b: FloatArray
+
+
+def _constraint_pairs(system: System) -> tuple[list[tuple[int, int]], list[str]]:
+    """Each constraint's rigid bodies as (a, b) (b = −1 for one body), and what keeps a
+    constraint out of a tree solve."""
+    pairs: list[tuple[int, int]] = []
+    problems: list[str] = []
+    lay = system.layout
+    for c in system.constraints:
+        who = f"{type(c).__name__} {c.name!r}"
+        if getattr(c, "unilateral", False):
+            problems.append(f"{who} is unilateral (the tree solve takes equalities only)")
+            continue
+        bodies = [system._resolve(r) for r in c.bodies]
+        if not 1 <= len(bodies) <= 2:
+            problems.append(f"{who} acts on {len(bodies)} bodies (the tree solve takes 1 or 2)")
+            continue
+        if any(b.kind is not BodyKind.RIGID for b in bodies):
+            problems.append(f"{who} acts on a body that is not rigid")
+            continue
+        idx = [lay.slot(b).index for b in bodies]
+        if len(idx) == 2 and idx[0] == idx[1]:
+            problems.append(f"{who} acts twice on one body")
+            continue
+        pairs.append((idx[0], idx[1] if len(idx) == 2 else -1))
+    return pairs, problems
+
+
+class TreeSolver(UKSolver):
+    """Tree-structured constraints on rigid bodies in linear time (Baraff 1996).
+
+    Applies when every body is rigid and every constraint is an equality on one rigid body
+    (to the ground) or two, with the constraints forming a tree or forest with the ground
+    (a robot's joints, fixed or floating base). The solve is the block LDLᵀ factorisation of
+    the module docstring, compiled: its cost grows linearly with the number of bodies. A
+    call whose rows it cannot certify to have full row rank (a Cholesky pivot, more than six
+    rows in one constraint) or whose residual is above the consistency test takes the dense
+    solve (up to :data:`DENSE_FALLBACK_DOF` dof; QR, else SVD) or the sparse one, which
+    decide the rank and warn as they do under those strategies. Above
+    :data:`DENSE_FALLBACK_DOF` dof the System keeps its rows and mass matrix in sparse blocks:
+    no n_dof × n_dof matrix is formed.
+    """
+
+    name = "tree"
+    sparse = False  # the System asks wants_sparse: by its size
+
+    @classmethod
+    def wants_sparse(cls, system: System) -> bool:
+        """Sparse rows and mass blocks above :data:`DENSE_FALLBACK_DOF` dof, dense below
+        (as the System keeps them for the dense strategies)."""
+        return system.layout.n_dof > DENSE_FALLBACK_DOF
+
+    def __init__(self, system: System) -> None:
+        super().__init__(system)
+        pairs, _ = _constraint_pairs(system)
+        structure = tree_structure(system.layout.n_rigid, pairs)
+        assert not isinstance(structure, str)  # problems() has checked it
+        self._order, self._parent = structure
+        self._pairs = pairs
+        self._width = [6 if b < 0 else 12 for _, b in pairs]
+        self._lay = lay = system.layout
+        self._n = lay.n_dof
+        self._V_shape = (lay.n_rigid, 6)
+        self._zero_loads = system._zero_loads
+        self._zero_z = system._zero_z
+        self._constraints = system.constraints
+        self._rows_n: list[int] | None = None
+        self._P = np.zeros(1)
+        terms = [c._compiled_term() for c in system.constraints]
+        # every constraint compiled: its rows in the same compiled call as the solve
+        self._cons: np.ndarray | None = None
+        self._cparams = np.zeros(1)
+        if all(t is not None for t in terms):  # the row counts are known: pack P now
+            rows = [int(t[2]) for t in terms if t is not None]
+            self._pack(rows)
+            table: list[list[int]] = []
+            cparams: list[float] = []
+            r0 = 0
+            for term, (ia, ib), k in zip(terms, pairs, rows, strict=True):
+                assert term is not None
+                kernel, values, _ = term
+                table.append([kernel_address(kernel, ROWS_KERNEL), ia, ib, r0, k, len(cparams)])
+                cparams += values
+                r0 += k
+            self._cons = np.array(table, dtype=np.int64).reshape(-1, 6)
+            self._cparams = np.array([*cparams, 0.0])
+            self._s = r0
+            _tree_rows_entry()
+        from gmuk.engine.system import _pair
+
+        self._pair = _pair
+        _tree_entry()
+
+    def _pack(self, rows: list[int]) -> None:
+        s = self.system
+        self._rows_n = rows
+        self._P = tree_params(
+            s._J, s._Jinv, s._m_rigid, self._order, self._parent, self._pairs, rows,
+            s.consistency_tol,
+        )  # fmt: skip
+
+    def loop_constants(self, state: State) -> np.ndarray:
+        """The packed tree (:func:`tree_params`) after its first two entries, which the
+        compiled program puts in front (``solve_constants`` of
+        :class:`gmuk.engine.integrators._program.SystemView`), with each constraint's row
+        count as it is at ``state``."""
+        self._blocks(state)  # packs the row counts of constraints evaluated in Python
+        return np.array(self._P[2:])
+
+    @classmethod
+    def problems(cls, system: System) -> list[str]:
+        """Rigid bodies only; equalities on one or two bodies forming a tree or forest with
+        the ground."""
+        out = []
+        if system.layout.n_euclid:
+            out.append("the tree solve takes rigid bodies only")
+        pairs, problems = _constraint_pairs(system)
+        out += problems
+        if not problems:
+            lay = system.layout
+            if not np.array_equal(lay.rigid_offsets, 6 * np.arange(lay.n_rigid)):
+                out.append("the tree solve takes rigid bodies only")
+            structure = tree_structure(lay.n_rigid, pairs)
+            if isinstance(structure, str):
+                out.append(structure)
+        return [f"solver 'tree': {p}" for p in out]
+
+    # -- rows in blocks
+    def _blocks(self, state: State) -> tuple[FloatArray, FloatArray]:
+        """Each constraint's rows (s, 12) on its first and second body, and b (s,)."""
+        pair = self._pair
+        got = []
+        for c, width in zip(self._constraints, self._width, strict=True):
+            Ai, bi = pair(c, state)
+            if not (
+                type(Ai) is np.ndarray
+                and type(bi) is np.ndarray
+                and Ai.dtype == np.float64
+                and bi.dtype == np.float64
+                and bi.ndim == 1
+                and Ai.shape == (bi.shape[0], width)
+            ):
+                Ai, bi = as_rows(Ai, bi, width, f"constraint {c.name!r}")
+                if hasattr(Ai, "toarray"):
+                    Ai = Ai.toarray()
+            got.append((Ai, bi))
+        rows = [bi.shape[0] for _, bi in got]
+        if rows != self._rows_n:
+            self._pack(rows)
+        s = sum(rows)
+        A = np.zeros((s, 12))
+        b = np.empty(s)
+        r = 0
+        for (Ai, bi), width in zip(got, self._width, strict=True):
+            k = bi.shape[0]
+            A[r : r + k, :width] = Ai
+            b[r : r + k] = bi
+            r += k
+        return A, b
+
+    def _dense(self, A: FloatArray) -> FloatArray:
+        """The stacked A (s, n_dof) of blocks (s, 12)."""
+        out = np.zeros((A.shape[0], self._n))
+        r = 0
+        for (ia, ib), k in zip(self._pairs, self._rows_n or [], strict=True):
+            out[r : r + k, 6 * ia : 6 * ia + 6] = A[r : r + k, :6]
+            if ib >= 0:
+                out[r : r + k, 6 * ib : 6 * ib + 6] = A[r : r + k, 6:]
+            r += k
+        return out
+
+    # -- the solve
+    def accelerations(self, state: State) -> Accelerations:
+        """One compiled call (free acceleration, tree solve, wrenches) when nothing acts on
+        the plant beyond the solve; the general path otherwise."""
+        system = self.system
+        modeled, unmodeled = self._loads(state)
+        if system._plant_only_loads:
+            return self._general(state, modeled, unmodeled, None)
+        n = self._n
+        V = state.V
+        status = -1.0
+        if self._cons is not None:  # rows and solve in one compiled call
+            s = self._s
+            A, b = np.zeros((s, 12)), np.empty(s)
+            out = np.empty(4 * n + s + 3)
+            if (
+                _tree_rows_c(
+                    float(state.t),
+                    np.array(state.g, dtype=float),  # writable copies: the kernels' types
+                    np.array(V, dtype=float),
+                    np.array(modeled, dtype=float),
+                    self._cons,
+                    self._cparams,
+                    self._P,
+                    A,
+                    b,
+                    out,
+                )
+                == 0
+            ):
+                status = float(out[-1])
+        if status < 0.0:  # rows in Python (or a constraint kernel failed: its error)
+            A, b = self._blocks(state)
+            s = b.size
+            out = np.empty(4 * n + s + 3)
+            if V.dtype == _F64 and V.shape == self._V_shape and V.flags.c_contiguous:
+                _tree_rigid_c(_writable(V), _writable(modeled), A, b, self._P, out)
+            else:
+                tree_rigid(np.ascontiguousarray(V, dtype=float), modeled, A, b, self._P, out)
+            status = float(out[-1])
+        if status == _SOLVED:
+            return Accelerations._from_dict(
+                {
+                    "layout": self._lay,
+                    "free": out[:n],
+                    "constraint": out[n : 2 * n],
+                    "extra": self._zero_loads,
+                    "total": out[2 * n : 3 * n],
+                    "constraint_force": out[3 * n : 4 * n],
+                    "control_force": self._zero_loads,
+                    "unmodeled_force": unmodeled,
+                    "multipliers": out[4 * n : 4 * n + s] if s else _NO_MULTIPLIERS,
+                    "residual": float(out[-3]),
+                    "rank": s,
+                    "unreachable": 0.0,
+                    "z_dot": self._zero_z,
+                }
+            )
+        if status == _NOT_FINITE:
+            self._not_finite(state)
+        return self._general(state, modeled, unmodeled, _Blocks(A, b))
+
+    def _not_finite(self, state: State) -> None:
+        self.system.constraint_rows(state)  # raises ConstraintError naming the constraint
+        raise ConstraintError(f"constraint rows at t = {state.t:.9g} s are not finite")
+
+    def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:
+        """The tree solve of the rows at ``state``, with the dense or sparse solve where it
+        cannot certify its answer (``rows``: the blocks a call could not certify, or None)."""
+        a = np.ascontiguousarray(a, dtype=float)
+        if isinstance(rows, _Blocks):
+            return self._fallback(state, a, rows.A, rows.b)
+        A, b = self._blocks(state)
+        if b.size == 0:
+            return np.zeros_like(a), np.zeros(0), 0, 0.0, 0.0
+        ac = np.zeros(self._n)
+        lam = np.zeros(b.size)
+        residual, scale, status = tree_solve(a, A, b, self._P, ac, lam)
+        if status == 0 and residual <= self.system.consistency_tol * scale:
+            return ac, lam, b.size, float(residual), 0.0
+        if status == 2 or not (all_finite(A) and all_finite(b)):
+            self._not_finite(state)
+        return self._fallback(state, a, A, b)
+
+    def _fallback(self, state: State, a: FloatArray, A: FloatArray, b: FloatArray) -> Solution:
+        """The dense (QR, else SVD) or sparse solve of the same rows, which decides the rank
+        and warns on inconsistent rows as under those strategies."""
+        system = self.system
+        A_full = self._dense(A)
+        if not system.sparse:
+            Ms = system._Minv_sqrt
+            rcond = system.rcond if system.rcond is not None else max(A_full.shape) * _EPS
+            if A_full.shape[0] <= QR_MAX_ROWS:
+                ac, lam, residual, scale, status = _uk_kernels.uk_qr(
+                    A_full, b, a, Ms, min(QR_COND_LIMIT, 0.1 / rcond)
+                )
+                if status == _SOLVED:
+                    self.check_consistency(state, residual, scale)
+                    return ac, lam, b.size, float(residual), 0.0
+            ac, lam, rank, residual, scale = _uk_kernels.uk_dense(A_full, b, a, Ms, rcond)
+            self.check_consistency(state, residual, scale)
+            return ac, lam, int(rank), float(residual), 0.0
+        import scipy.sparse as sp
+
+        A_sp = sp.csr_matrix(A_full)
+        ac, lam, rank_sp = uk.solve_sparse(
+            A_sp, b - A_sp @ a, system._Minv_sp, system._Minv_sqrt_sp, system.sparse_solver
+        )
+        residual = float(np.linalg.norm(A_sp @ (a + ac) - b))
+        scale = float(
+            consistency_scale(
+                np.sqrt(b @ b), np.sqrt(np.sum(A * A)), np.linalg.norm(a), np.linalg.norm(ac)
+            )
+        )
+        self.check_consistency(state, residual, scale)
+        return ac, lam, rank_sp, residual, 0.0

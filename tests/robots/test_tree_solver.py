@@ -1,0 +1,330 @@
+"""The linear-time tree solve (gmuk.engine.tree, Baraff 1996) against the dense solve and
+Pinocchio's ABA.
+
+For full-row-rank rows the KKT solution is unique, so the tree solve's accelerations,
+multipliers and constraint wrenches must equal the dense (QR / SVD) solve's to round-off; on
+robots from URDF its joint accelerations must equal ``pin.aba``'s. Rows it cannot certify
+take the dense solve, and the compiled loop runs it without calling back into Python.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import gmuk
+from gmuk.constraints.base import Constraint
+from gmuk.engine.tree import TREE, TreeSolver, tree_structure
+from gmuk.errors import DefinitionError
+from gmuk.lie import se3
+from gmuk.robots import (
+    CylindricalJoint,
+    FixedJoint,
+    PlanarJoint,
+    PrismaticJoint,
+    RevoluteJoint,
+    Robot,
+    SphericalJoint,
+    UniversalJoint,
+    example_robot_data,
+)
+
+FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
+ROBOTS = {
+    "panda": ("panda_description/urdf/panda.urdf", "fixed", FINGERS),
+    "solo12": ("solo_description/robots/solo12.urdf", "floating", ()),
+    "ur5": ("ur_description/urdf/ur5_robot.urdf", "fixed", ()),
+}
+#: What "the same to round-off" means here: relative to the largest entry of the field.
+RTOL = 1e-12
+FIELDS = ("free", "constraint", "total", "constraint_force", "multipliers")
+
+
+def _robot(name: str, **kw) -> Robot:
+    path, base, locked = ROBOTS[name]
+    return Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked, **kw)
+
+
+def _random_qv(model, rng):
+    pin.seed(int(rng.integers(2**31)))
+    q = pin.randomConfiguration(model, -2.0 * np.ones(model.nq), 2.0 * np.ones(model.nq))
+    return q, rng.normal(size=model.nv)
+
+
+def _relative(got, expected) -> float:
+    scale = max(float(np.abs(expected).max(initial=0.0)), 1e-300)
+    return float(np.abs(np.asarray(got) - np.asarray(expected)).max(initial=0.0)) / scale
+
+
+def _assert_same(acc_tree, acc_dense) -> None:
+    for field in FIELDS:
+        err = _relative(getattr(acc_tree, field), getattr(acc_dense, field))
+        assert err <= RTOL, f"{field}: relative difference {err:.3g}"
+    assert acc_tree.rank == acc_dense.rank == acc_tree.multipliers.size
+    assert acc_tree.residual <= 1e-9 * max(1.0, float(np.abs(acc_tree.total).max()))
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_tree_equals_dense_on_robots(name):
+    """Accelerations, multipliers and constraint wrenches at random states, with gravity and
+    joint damping (force models evaluated in Python) acting."""
+    tree = _robot(name, solver="tree", damping=0.7)
+    dense = _robot(name, solver="dense", damping=0.7)
+    assert isinstance(tree.system.solver, TreeSolver)
+    rng = np.random.default_rng(28)
+    for _ in range(5):
+        q, v = _random_qv(tree.model, rng)
+        _assert_same(
+            tree.system.accelerations(tree.state(q, v)),
+            dense.system.accelerations(dense.state(q, v)),
+        )
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_tree_joint_accelerations_equal_pinocchio_aba(name):
+    robot = _robot(name, solver="tree")
+    model = robot.model
+    data = model.createData()
+    rng = np.random.default_rng(96)
+    for _ in range(5):
+        q, v = _random_qv(model, rng)
+        tau = rng.normal(size=model.nv)
+        expected = pin.aba(model, data, q, v, tau)
+        got = robot.forward_dynamics(q, v, tau)
+        err = np.linalg.norm(got - expected) / max(1.0, np.linalg.norm(expected))
+        assert err <= 1e-10
+
+
+def _links(n: int) -> list[gmuk.RigidBody]:
+    rng = np.random.default_rng(n)
+    out = []
+    for i in range(n):
+        m = 0.5 + rng.random()
+        J = np.diag(0.03 + 0.02 * rng.random(3))  # principal moments within a factor 5/3
+        out.append(gmuk.RigidBody(f"l{i}", m, J))
+    return out
+
+
+def _random_state(system: gmuk.System, seed: int) -> gmuk.State:
+    rng = np.random.default_rng(seed)
+    g, V = {}, {}
+    for b in system.bodies:
+        g[b.name] = se3.exp(rng.normal(size=6))
+        V[b.name] = rng.normal(size=6)
+    return system.state(g=g, V=V)
+
+
+def _same_state(system: gmuk.System, state: gmuk.State) -> gmuk.State:
+    """``state`` as a state of ``system`` (the same bodies)."""
+    names = [b.name for b in system.bodies]
+    return system.state(
+        g={n: state.g[i] for i, n in enumerate(names)},
+        V={n: state.V[i] for i, n in enumerate(names)},
+    )
+
+
+def _half(x: float) -> np.ndarray:
+    X = np.eye(4)
+    X[0, 3] = x
+    return X
+
+
+def _chain(n: int, **kw) -> gmuk.System:
+    links = _links(n)
+    half = _half(0.15)
+    joints = [RevoluteJoint(None, links[0], child_frame=np.linalg.inv(half))]
+    joints += [
+        RevoluteJoint(
+            links[i - 1],
+            links[i],
+            axis=(0.0, 1.0 if i % 2 else 0.0, 1.0),
+            parent_frame=half,
+            child_frame=np.linalg.inv(half),
+        )
+        for i in range(1, n)
+    ]
+    return gmuk.System(links, joints, [gmuk.UniformGravity((0.0, -9.81, 0.0))], **kw)
+
+
+def test_long_chain_equals_dense():
+    """60 links, 300 rows: beyond the dense solve's QR (it takes the SVD)."""
+    tree, dense = _chain(60, solver="tree"), _chain(60, solver="dense")
+    state = _random_state(tree, 1)
+    _assert_same(tree.accelerations(state), dense.accelerations(_same_state(dense, state)))
+
+
+def _branched(**kw) -> gmuk.System:
+    """A forest: a grounded tree with every joint kind and branching bodies, a floating tree
+    (no joint to the ground) and a lone free body."""
+    b = _links(12)
+    X = _half(0.2)
+    Xi = np.linalg.inv(X)
+    joints = [
+        SphericalJoint(None, b[0], child_frame=Xi),
+        RevoluteJoint(b[0], b[1], parent_frame=X, child_frame=Xi),
+        PrismaticJoint(b[0], b[2], axis=(0, 1, 0), parent_frame=X, child_frame=Xi),
+        UniversalJoint(b[0], b[3], parent_frame=X, child_frame=Xi),
+        CylindricalJoint(b[1], b[4], axis=(1, 0, 0), parent_frame=X, child_frame=Xi),
+        FixedJoint(b[4], b[5], parent_frame=X, child_frame=Xi),
+        PlanarJoint(b[2], b[6], parent_frame=X, child_frame=Xi),
+        # a floating tree rooted at b[7], its joints listed child-first for the other order
+        RevoluteJoint(b[8], b[9], parent_frame=X, child_frame=Xi),
+        SphericalJoint(b[7], b[8], parent_frame=X, child_frame=Xi),
+        PrismaticJoint(b[7], b[10], parent_frame=X, child_frame=Xi),
+    ]
+    forces = [gmuk.UniformGravity((0.0, 0.0, -9.81))]
+    return gmuk.System(b, joints, forces, **kw)
+
+
+def test_branched_forest_equals_dense():
+    tree, dense = _branched(solver="tree"), _branched(solver="dense")
+    for seed in range(4):
+        state = _random_state(tree, seed)
+        _assert_same(tree.accelerations(state), dense.accelerations(_same_state(dense, state)))
+
+
+def test_tree_structure_orders_children_first():
+    # 0 — 1 — 2 by constraints 0 (ground–0), 1 (0–1), 2 (2–1)
+    order, parent = tree_structure(3, [(0, -1), (0, 1), (2, 1)])
+    place = {int(node): k for k, node in enumerate(order)}
+    for node, p in enumerate(parent):
+        if p >= 0:
+            assert place[node] < place[int(p)]
+    assert parent[3] == -1  # the joint to the ground is the root
+    assert isinstance(tree_structure(2, [(0, -1), (1, -1), (0, 1)]), str)  # through the ground
+    assert isinstance(tree_structure(2, [(0, 1), (1, 0)]), str)  # two constraints, one pair
+
+
+def test_refuses_what_is_not_a_tree():
+    links = _links(4)
+    X, Xi = _half(0.2), np.linalg.inv(_half(0.2))
+    loop = [
+        RevoluteJoint(None, links[0], child_frame=Xi),
+        RevoluteJoint(links[0], links[1], parent_frame=X, child_frame=Xi),
+        RevoluteJoint(None, links[1], parent_frame=_half(1.0), child_frame=X),
+    ]
+    with pytest.raises(DefinitionError, match="close a loop"):
+        gmuk.System(links[:2], loop, solver="tree")
+    point = gmuk.PointMass("p", 1.0)
+    with pytest.raises(DefinitionError, match="rigid bodies only"):
+        gmuk.System([links[0], point], [RevoluteJoint(None, links[0])], solver="tree")
+
+
+class _Redundant(Constraint):
+    """Two copies of one row on one body (to the ground): A has rank 1."""
+
+    def rows(self, state):
+        row = np.array([0.0, 0.0, 0.0, 1.0, 0.5, 0.0])
+        return np.vstack([row, 2.0 * row]), np.array([1.0, 2.0])
+
+
+def test_rows_without_full_rank_take_the_dense_solve():
+    """The tree solve cannot certify these rows, so the SVD decides: the same minimum-norm
+    answer and rank as the dense strategy."""
+    body = _links(1)[0]
+    tree = gmuk.System([body], [_Redundant([body])], solver="tree")
+    dense = gmuk.System([body], [_Redundant([body])], solver="dense")
+    state = _random_state(tree, 3)
+    got = tree.accelerations(state)
+    expected = dense.accelerations(_same_state(dense, state))
+    assert got.rank == expected.rank == 1
+    for field in FIELDS:
+        assert _relative(getattr(got, field), getattr(expected, field)) <= RTOL
+
+
+class _PythonRevolute(RevoluteJoint):
+    """A revolute joint whose rows come from Python (no compiled form)."""
+
+    def rows(self, state):
+        return super().rows(state)
+
+
+def _python_rows_chain(n: int) -> gmuk.System:
+    links = _links(n)
+    half = _half(0.15)
+    joints = [RevoluteJoint(None, links[0], child_frame=np.linalg.inv(half))]
+    joints += [
+        (_PythonRevolute if i % 2 else RevoluteJoint)(
+            links[i - 1], links[i], parent_frame=half, child_frame=np.linalg.inv(half)
+        )
+        for i in range(1, n)
+    ]
+    return gmuk.System(links, joints, [gmuk.UniformGravity((0.0, -9.81, 0.0))], solver="tree")
+
+
+def _count_python_solves(system: gmuk.System) -> list[int]:
+    """Counts the System's accelerations in Python (the loop's PHASE_ACCELERATIONS)."""
+    calls = [0]
+    inner = system._accelerations
+
+    def counted(state):
+        calls[0] += 1
+        return inner(state)
+
+    system._accelerations = counted
+    return calls
+
+
+def test_compiled_loop_runs_the_tree_solve():
+    """Panda: the same trajectory as the fused strategy, with no solve in Python per step."""
+    path, _, locked = ROBOTS["panda"]
+    tree = Robot.from_urdf(example_robot_data(path), locked_joints=locked, solver="tree")
+    fused = Robot.from_urdf(example_robot_data(path), locked_joints=locked)
+    assert tree.system.compiled_solve == (TREE, "")
+    rng = np.random.default_rng(12)
+    q0, v0 = _random_qv(tree.model, rng)
+    calls = _count_python_solves(tree.system)
+    t = np.linspace(0.0, 0.3, 4)
+    a = tree.system.simulate(tree.state(q0, v0), (0.0, 0.3), t_eval=t)
+    b = fused.system.simulate(fused.state(q0, v0), (0.0, 0.3), t_eval=t)
+    assert a.stats["compiled"] and a.stats["n_rhs"] > 100
+    assert calls[0] <= 2  # the checks at the start, not the steps
+    assert np.abs(tree.configuration(a) - fused.configuration(b)).max() <= 1e-9
+    assert np.abs(np.asarray(a.multipliers) - np.asarray(b.multipliers)).max() <= 1e-6 * max(
+        1.0, float(np.abs(np.asarray(b.multipliers)).max())
+    )
+
+
+def test_compiled_loop_takes_rows_from_python():
+    """Constraints without a compiled form: their dense rows go into the tree's blocks."""
+    system = _python_rows_chain(6)
+    links = system.bodies
+    g, V = {}, {}
+    for i, body in enumerate(links):
+        pose = np.eye(4)
+        pose[0, 3] = 0.3 * i + 0.15
+        g[body.name], V[body.name] = pose, np.zeros(6)
+    state = system.state(g=g, V=V)
+    calls = _count_python_solves(system)
+    traj = system.simulate(state, (0.0, 0.2), t_eval=[0.0, 0.1, 0.2])
+    assert calls[0] <= 2
+    compiled = _chain_like(system)
+    reference = compiled.simulate(compiled.state(g=g, V=V), (0.0, 0.2), t_eval=[0.0, 0.1, 0.2])
+    assert np.abs(np.asarray(traj.acceleration) - np.asarray(reference.acceleration)).max() <= 1e-8
+
+
+def _chain_like(system: gmuk.System) -> gmuk.System:
+    """The same System with every joint's compiled form, under the dense strategy."""
+    joints = [
+        RevoluteJoint(
+            j.parent, j.child, axis=j.axis, parent_frame=j.parent_frame, child_frame=j.child_frame
+        )
+        for j in system.constraints
+    ]
+    return gmuk.System(list(system.bodies), joints, list(system.forces), solver="dense")
+
+
+def test_rows_without_full_rank_on_a_large_system_take_the_sparse_solve():
+    """Above the dense threshold the System keeps sparse blocks, and the uncertified rows go
+    to the sparse solve (minimum norm by LSMR): the same accelerations as the SVD."""
+    bodies = _links(51)  # 306 dof
+    tree = gmuk.System(bodies, [_Redundant([bodies[0]])], solver="tree")
+    dense = gmuk.System(bodies, [_Redundant([bodies[0]])], solver="dense")
+    assert tree.sparse and not dense.sparse
+    state = _random_state(tree, 5)
+    got = tree.accelerations(state)
+    expected = dense.accelerations(_same_state(dense, state))
+    assert expected.rank == 1
+    for field in ("total", "constraint", "constraint_force"):
+        assert _relative(getattr(got, field), getattr(expected, field)) <= 1e-10
