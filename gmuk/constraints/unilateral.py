@@ -18,6 +18,10 @@ conditions fail by design in transients (McCann 2020, Section 6.5.1).
 A gap that closes with a velocity (an impact) needs an impulse: see
 :func:`gmuk.engine.contact.simulate_with_impacts` (impulsive Udwadia–Kalaba with Newton's
 restitution law).
+
+A :class:`PointPlaneContact` may carry Coulomb friction (``friction=μ``): each closed point then
+also has two tangential rows, whose multipliers are the friction force, ``‖f_t‖ ≤ μ f_n``
+(:func:`gmuk.engine.contact.solve_with_friction`).
 """
 
 from __future__ import annotations
@@ -41,6 +45,7 @@ if TYPE_CHECKING:
 __all__ = [
     "CLOSED_GAP",
     "CLOSED_RATE",
+    "SLIP_SPEED",
     "JointLimit",
     "PointPlaneContact",
     "UnilateralConstraint",
@@ -51,6 +56,10 @@ CLOSED_GAP = 1e-9
 #: … when it is neither opening nor closing faster than this (m/s or rad/s): slower
 #: approaches are absorbed by the contact's stabilised row, faster ones are impacts.
 CLOSED_RATE = 1e-6
+#: A closed point with friction slides when its tangential speed exceeds this (m/s): the
+#: friction is then kinetic, ``−μ f_n v_t/‖v_t‖``; at or below it the point sticks unless the
+#: friction it needs leaves the cone.
+SLIP_SPEED = 1e-6
 
 _FORMS = Forms(
     compiled="a complementarity problem: the contact solve runs in Python",
@@ -79,6 +88,9 @@ class UnilateralConstraint(Constraint):
 
     #: Marks the kind for the System, which then takes the contact solve.
     unilateral: ClassVar[bool] = True
+    #: Coulomb's friction coefficient μ of the closed gaps (0: frictionless; only
+    #: :class:`PointPlaneContact` takes one).
+    friction: float = 0.0
     _forms = _FORMS
 
     def __init__(
@@ -123,13 +135,25 @@ class UnilateralConstraint(Constraint):
 
 
 class PointPlaneContact(UnilateralConstraint):
-    """Points of a rigid body that may not go below a fixed plane (frictionless contact).
+    """Points of a rigid body that may not go below a fixed plane, with or without Coulomb
+    friction.
 
     The plane is ``{x : n·x = h}`` in N with unit normal n pointing to the free side; point
     k at ``p_k`` in the body frame has gap ``φ_k = n·(r + R p_k) − h`` (m), rate
     ``φ̇_k = n·R(v + ω × p_k)`` and acceleration
     ``φ̈_k = mᵀ v̇ + (p_k × m)ᵀ ω̇ + mᵀ (ω × (v + ω × p_k))`` with ``m = Rᵀn``: the row
     ``a_k = [(p_k × m)ᵀ, mᵀ]``, ``b_k = −mᵀ(ω × (v + ω × p_k)) − α φ̇_k − β φ_k``.
+
+    With ``friction=μ > 0`` the constraint has 3k rows: the k normal rows first, then two
+    tangential rows per point, along the plane's fixed tangents ``t₁, t₂`` (:attr:`tangents`,
+    with ``t₁ × t₂ = n``): ``[(p_k × m_j)ᵀ, m_jᵀ] ν̇ = −m_jᵀ(ω × (v + ω × p_k)) − γ u_j``,
+    ``m_j = Rᵀt_j``, the point's tangential acceleration held at ``−γ u`` (u (2,) its tangential
+    velocity :meth:`tangential_velocities`, γ = √β of the Baumgarte gains, 100 1/s by
+    default), which is what a sticking point needs. Their multipliers are the friction force
+    ``f_t`` (N, in t₁, t₂) at each closed point, which the contact solve keeps in Coulomb's
+    cone ``‖f_t‖ ≤ μ f_n``: sticking while the cone can hold the point, kinetic
+    ``−μ f_n u/‖u‖`` while it slides (:func:`gmuk.engine.contact.solve_with_friction`); an open
+    point has none. The cone is the exact (circular) one, not a polyhedral approximation.
 
     Parameters
     ----------
@@ -140,8 +164,12 @@ class PointPlaneContact(UnilateralConstraint):
         n in N (normalised here); default +z.
     height : float
         h (m).
+    friction : float
+        Coulomb's coefficient μ ≥ 0 (dimensionless), static and kinetic alike; 0 (the
+        default) is the frictionless contact, with its k rows.
     restitution, baumgarte, name
-        See :class:`UnilateralConstraint`.
+        See :class:`UnilateralConstraint`. Impacts are frictionless: the impulse acts
+        along the normal only.
     """
 
     body_kinds = frozenset({BodyKind.RIGID})
@@ -154,11 +182,13 @@ class PointPlaneContact(UnilateralConstraint):
         *,
         normal: Any = (0.0, 0.0, 1.0),
         height: float = 0.0,
+        friction: float = 0.0,
         restitution: float = 0.0,
         baumgarte: Baumgarte | None = None,
         name: str | None = None,
     ) -> None:
         super().__init__([body], restitution=restitution, baumgarte=baumgarte, name=name)
+        self.friction = real_number(friction, "friction", non_negative=True)
         pts = np.asarray(points, dtype=float)
         if pts.ndim == 1:
             pts = pts[None, :]
@@ -171,6 +201,11 @@ class PointPlaneContact(UnilateralConstraint):
             raise DefinitionError(f"normal must be a nonzero 3-vector; got {n.tolist()}")
         self.normal = n / norm
         self.height = real_number(height, "height")
+        # t₁ ⟂ n from the axis least along n, t₂ = n × t₁: a right-handed (t₁, t₂, n)
+        t1 = np.cross(np.eye(3)[int(np.argmin(np.abs(self.normal)))], self.normal)
+        t1 /= np.linalg.norm(t1)
+        #: (2, 3): the plane's tangents t₁, t₂ in N (rows), the axes of the friction force.
+        self.tangents = np.array([t1, np.cross(self.normal, t1)])
 
     def _body_state(self, state: State) -> tuple[FloatArray, FloatArray]:
         (i,) = self._rigid_indices(state)
@@ -186,16 +221,39 @@ class PointPlaneContact(UnilateralConstraint):
         return phi, rate
 
     def rows(self, state: State) -> tuple[FloatArray, FloatArray]:
-        """(A (k, 6), b (k,)): ``φ̈_k ≥ −α φ̇_k − β φ_k`` for each point, open or closed."""
+        """(A (k, 6), b (k,)): ``φ̈_k ≥ −α φ̇_k − β φ_k`` for each point, open or closed; with
+        friction (A (3k, 6), b (3k,)), point i's tangential rows at k + 2i and k + 2i + 1 (class
+        docstring)."""
         g, V = self._body_state(state)
         m = g[:3, :3].T @ self.normal
         w, v = V[:3], V[3:]
-        A = np.empty((self.points.shape[0], 6))
+        k = self.points.shape[0]
+        A = np.empty((k, 6))
         A[:, :3] = np.cross(self.points, m)
         A[:, 3:] = m
         u = v + np.cross(w, self.points)
         b = -(np.cross(w, u) @ m)
-        return A, self._stabilised(state, b)
+        if self.friction == 0.0:
+            return A, self._stabilised(state, b)
+        mt = self.tangents @ g[:3, :3]  # (2, 3): m_j = Rᵀ t_j as rows
+        At = np.empty((k, 2, 6))
+        At[:, :, :3] = np.cross(self.points[:, None, :], mt[None, :, :])
+        At[:, :, 3:] = mt[None, :, :]
+        bt = -(np.cross(w, u) @ mt.T) - self._slip_gain() * (u @ mt.T)
+        return np.vstack([A, At.reshape(2 * k, 6)]), np.concatenate(
+            [self._stabilised(state, b), bt.reshape(2 * k)]
+        )
+
+    def _slip_gain(self) -> FloatArray:
+        """γ (k, 1) (1/s): the tangential rows' velocity gain, √β of the Baumgarte gains."""
+        beta = np.broadcast_to(np.asarray(self.baumgarte.beta, dtype=float), (len(self.points),))
+        return np.sqrt(beta)[:, None]
+
+    def tangential_velocities(self, state: State) -> FloatArray:
+        """u (k, 2) (m/s): each point's velocity along the plane's tangents t₁, t₂."""
+        g, V = self._body_state(state)
+        u_N = (V[3:] + np.cross(V[:3], self.points)) @ g[:3, :3].T
+        return np.asarray(u_N @ self.tangents.T, dtype=float)
 
 
 class JointLimit(UnilateralConstraint):

@@ -17,6 +17,12 @@ Udwadia–Kalaba): ``min ½ (ν⁺ − ν⁻)ᵀ M (ν⁺ − ν⁻)`` subject t
 velocity, ``A ν⁺ = A ν⁻``, and each closed gap leaving with at least −e times its approach
 rate (Newton's law of restitution), ``a_k ν⁺ ≥ −e a_k ν⁻``. :func:`simulate_with_impacts` runs a
 System with events on its unilateral gaps and applies an impulse at each.
+
+Coulomb friction (:class:`~gmuk.constraints.unilateral.PointPlaneContact` with ``friction=μ``)
+makes the problem a complementarity problem that is no longer Gauss's principle;
+:func:`solve_with_friction` solves it by staggered projections (Kaufman et al. 2008) at the
+acceleration level: the normal problem above with the friction forces held as applied forces,
+then the friction problem with the normal forces held, alternated to a fixed point.
 """
 
 from __future__ import annotations
@@ -28,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gmuk._validation import FloatArray
-from gmuk.constraints.unilateral import CLOSED_GAP, UnilateralConstraint
+from gmuk.constraints.unilateral import CLOSED_GAP, SLIP_SPEED, UnilateralConstraint
 from gmuk.engine import segments
 from gmuk.engine.events import Event
 from gmuk.engine.solvers import DenseSolver, Solution
@@ -40,12 +46,15 @@ if TYPE_CHECKING:
     from gmuk.engine.system import System
 
 __all__ = [
+    "FRICTION_TOL",
     "ContactKKT",
     "ContactSolver",
+    "FrictionRows",
     "contact_kkt",
     "impulse",
     "project",
     "simulate_with_impacts",
+    "solve_with_friction",
     "solve_with_inequalities",
 ]
 
@@ -134,6 +143,346 @@ def solve_with_inequalities(
     return ac, lam, rank, residual
 
 
+#: The friction iteration (:func:`solve_with_friction`) has converged when no friction force
+#: changes by more than this times the largest cone radius μ f_n between two rounds.
+FRICTION_TOL = 1e-10
+#: Rounds of the staggered iteration before it gives up (SimulationError).
+FRICTION_MAX_ROUNDS = 1000
+#: Sweeps of the friction problem's block descent within one round (round-off can keep the
+#: last digits of a redundant set of points moving; the rounds' test decides convergence).
+_MAX_SWEEPS = 200
+
+
+@dataclasses.dataclass(frozen=True)
+class FrictionRows:
+    """The m closed points with friction in a stack of rows (:func:`solve_with_friction`).
+
+    Attributes
+    ----------
+    normal : ndarray (m,) of int
+        Each point's normal row.
+    tangent : ndarray (m, 2) of int
+        Its two tangential rows (the tangential acceleration along t₁, t₂ held at the row's
+        right-hand side when it sticks; the multipliers are the friction force, N).
+    mu : ndarray (m,)
+        Coulomb's coefficient of each point.
+    velocity : ndarray (m, 2)
+        Each point's tangential velocity along t₁, t₂ (m/s): above
+        :data:`~gmuk.constraints.unilateral.SLIP_SPEED` it slides.
+    """
+
+    normal: np.ndarray
+    tangent: np.ndarray
+    mu: FloatArray
+    velocity: FloatArray
+
+
+def solve_with_friction(
+    a: FloatArray,
+    Minv_sqrt: FloatArray,
+    A: FloatArray,
+    b: FloatArray,
+    equal: np.ndarray,
+    candidates: np.ndarray,
+    friction: FrictionRows,
+    rcond: float | None = None,
+) -> tuple[FloatArray, FloatArray, int, float]:
+    """:func:`solve_with_inequalities` with Coulomb friction at the points ``friction``.
+
+    The contact force at a closed point is ``f_n n + f_t`` with ``f_n ≥ 0`` complementary to
+    the normal row (as without friction) and ``‖f_t‖ ≤ μ f_n`` (Coulomb's circular cone).
+    A point sliding with tangential velocity u (``‖u‖ >`` :data:`SLIP_SPEED`) gets the kinetic
+    force ``f_t = −μ f_n u/‖u‖``. A point at rest gets the force of maximal dissipation at
+    the acceleration level: the minimiser of ``½ f_tᵀ W f_t + r₀ᵀ f_t`` over the cones, where
+    ``r(f_t) = r₀ + W f_t`` is the sticking points' tangential-row residual
+    ``T ν̇ − b_T`` and ``W = T M^{-1/2} P M^{-1/2} Tᵀ`` their Delassus matrix (P: the projector
+    on the null space of the bilateral rows, which respond to the friction): it holds the
+    point (``r = 0``) when the cone allows, and otherwise opposes its tangential acceleration
+    with the whole ``μ f_n`` (Moreau's and Glocker's sticking law; Pfeiffer and Glocker 1996,
+    Ch. 5).
+
+    When no point slides, every point held is tried first: Gauss's principle with the
+    tangential rows as equalities, then the least-norm contact forces giving its constraint
+    force with each friction force in the polygon of 16 sides inscribed in its cone (two
+    least-distance programs); if there are none, the iteration below decides.
+
+    The coupled problem is solved by staggered projections (Kaufman, Sueda, James and Pai
+    2008, at the acceleration level instead of the velocity level): the normal problem —
+    Gauss's principle with the friction forces applied, :func:`solve_with_inequalities` —
+    then the friction problem with the normal forces held — the kinetic forces set, the
+    sticking ones by block coordinate descent over the points (each point's two-dimensional
+    problem on its disk solved exactly, a secular equation; Jourdan, Alart and Jean 1998) —
+    alternated from zero friction until no friction force changes by more than
+    :data:`FRICTION_TOL` times the largest ``μ f_n``. The accelerations returned are those of
+    the last normal problem with the last friction forces, so ``M ν̇_c = Aᵀλ`` and the normal
+    rows' KKT conditions hold to round-off; the cone and the sticking rows hold to the
+    iteration's tolerance. The fixed point exists and the iteration converges for the
+    moderate μ of common contacts; with large μ the acceleration-level problem may have no
+    solution (Painlevé's paradox), and then the iteration stops with a SimulationError.
+
+    Parameters
+    ----------
+    a, Minv_sqrt, A, b, equal, candidates, rcond
+        As for :func:`solve_with_inequalities`.
+    friction : FrictionRows
+        The closed points with friction (their normal rows among ``candidates``).
+
+    Returns
+    -------
+    As :func:`solve_with_inequalities`; the multipliers of the tangential rows are the
+    friction forces (N, along t₁, t₂).
+
+    Raises
+    ------
+    SimulationError
+        When the inequalities cannot hold, or the iteration does not converge in
+        :data:`FRICTION_MAX_ROUNDS` rounds.
+
+    References
+    ----------
+    Kaufman, D. M., Sueda, S., James, D. L. and Pai, D. K. (2008), Staggered projections for
+    frictional contact in multibody systems, ACM Trans. Graph. 27(5), 164.
+    Jourdan, F., Alart, P. and Jean, M. (1998), A Gauss–Seidel like algorithm to solve
+    frictional contact problems, Comput. Methods Appl. Mech. Engrg. 155, 31–47.
+    Pfeiffer, F. and Glocker, C. (1996), Multibody Dynamics with Unilateral Contacts, Wiley.
+    """
+    m = friction.mu.size
+    speed = np.linalg.norm(friction.velocity, axis=1)
+    sliding = speed > SLIP_SPEED
+    direction = np.zeros((m, 2))
+    direction[sliding] = friction.velocity[sliding] / speed[sliding, None]
+    stick = np.flatnonzero(~sliding)
+    tangent_rows = friction.tangent.reshape(-1)
+    G_T = A[tangent_rows] @ Minv_sqrt
+    stick_rows = friction.tangent[stick].reshape(-1)
+    W = np.zeros((0, 0))
+    if stick.size:
+        G_s = A[stick_rows] @ Minv_sqrt
+        if equal.size:  # the bilateral rows respond: W = G_s P G_sᵀ, P = N Nᵀ
+            G_e = A[equal] @ Minv_sqrt
+            _, sv, Vt = np.linalg.svd(G_e, full_matrices=True)
+            cut = (rcond if rcond is not None else max(G_e.shape) * _EPS) * (
+                sv[0] if sv.size else 0.0
+            )
+            G_s = G_s @ Vt[int((sv > cut).sum()) :].T
+        W = G_s @ G_s.T
+    if not sliding.any():  # every point sticks, if the cones can hold them all
+        held = _all_sticking(a, Minv_sqrt, A, b, equal, candidates, friction, rcond)
+        if held is not None:
+            return held
+    f = np.zeros((m, 2))
+    for _ in range(FRICTION_MAX_ROUNDS):
+        shift = Minv_sqrt @ (G_T.T @ f.reshape(-1))  # M⁻¹ Tᵀ f_t
+        ac_n, lam, rank, residual = solve_with_inequalities(
+            a + shift, Minv_sqrt, A, b, equal, candidates, rcond
+        )
+        ac = shift + ac_n
+        lam = _least_norm_normals(A, b, a + ac, a, lam, equal, candidates)
+        radius = friction.mu * np.maximum(lam[friction.normal], 0.0)
+        new = np.zeros((m, 2))
+        new[sliding] = -radius[sliding, None] * direction[sliding]
+        scale = float(radius.max(initial=0.0))
+        if stick.size:
+            r = A[stick_rows] @ (a + ac) - b[stick_rows]
+            new[stick] = _disk_descent(W, r, f[stick], radius[stick], FRICTION_TOL * scale)
+        converged = float(np.abs(new - f).max(initial=0.0)) <= FRICTION_TOL * scale
+        if converged:
+            break
+        f = new
+    else:
+        raise SimulationError(
+            f"the friction iteration did not converge in {FRICTION_MAX_ROUNDS} rounds (a "
+            "coefficient too large for the acceleration-level problem: Painlevé's paradox?)"
+        )
+    lam[tangent_rows] = f.reshape(-1)
+    return ac, lam, rank, residual
+
+
+#: Sides of the polygon inscribed in each cone within which :func:`_all_sticking` looks for
+#: the friction forces (a polygon, so that the search is a least-distance program).
+_CONE_SIDES = 16
+
+
+def _all_sticking(
+    a: FloatArray,
+    Minv_sqrt: FloatArray,
+    A: FloatArray,
+    b: FloatArray,
+    equal: np.ndarray,
+    candidates: np.ndarray,
+    friction: FrictionRows,
+    rcond: float | None,
+) -> tuple[FloatArray, FloatArray, int, float] | None:
+    """Every friction point held: Gauss's principle with the tangential rows as equalities,
+    then the least-norm contact forces giving the same constraint force with each friction
+    force within the polygon of :data:`_CONE_SIDES` sides inscribed in its cone
+    (``d_j·f_t ≤ μ cos(π/K) f_n``), both least-distance programs. None when no such forces
+    exist (some point must slip, or lies near its cone's edge): the staggered iteration
+    then decides."""
+    stick_rows = friction.tangent.reshape(-1)
+    held = np.concatenate([equal, stick_rows])
+    try:
+        ac, lam0, rank, _ = solve_with_inequalities(a, Minv_sqrt, A, b, held, candidates, rcond)
+    except SimulationError:
+        return None
+    acc = a + ac
+    slack = A[candidates] @ acc - b[candidates]
+    size = float(np.abs(b[candidates]).max(initial=0.0)) + float(
+        np.abs(A[candidates]).max(initial=0.0)
+    ) * (float(np.abs(acc).max(initial=0.0)) + float(np.abs(a).max(initial=0.0)))
+    shut = (lam0[candidates] > 0.0) | (slack <= 1e-10 * size)
+    rows = np.concatenate([candidates, stick_rows])  # the unknowns: normal, then tangential
+    p, m = candidates.size, friction.mu.size
+    G = A[rows].T  # (n, p + 2m)
+    Q0 = G @ lam0[rows]
+    n = G.shape[0]
+    Q = Q0
+    if equal.size:
+        proj = np.eye(n) - np.linalg.pinv(A[equal]) @ A[equal]
+        G, Q = proj @ G, proj @ Q
+    where = {int(r): j for j, r in enumerate(candidates)}
+    angles = 2.0 * np.pi * np.arange(_CONE_SIDES) / _CONE_SIDES
+    d = np.stack([np.cos(angles), np.sin(angles)], axis=1)  # (K, 2)
+    ineq = np.zeros((p + _CONE_SIDES * m, p + 2 * m))
+    ineq[:p, :p] = np.eye(p)
+    for i in range(m):
+        block = slice(p + _CONE_SIDES * i, p + _CONE_SIDES * (i + 1))
+        ineq[block, where[int(friction.normal[i])]] = friction.mu[i] * np.cos(np.pi / _CONE_SIDES)
+        ineq[block, p + 2 * i : p + 2 * i + 2] = -d
+    off = np.flatnonzero(~shut)  # normal rows with slack: no force there
+    eq_rows = np.vstack([G, np.eye(p + 2 * m)[off]])
+    stacked = np.vstack([eq_rows, ineq])
+    rhs = np.concatenate([Q, np.zeros(off.size), np.zeros(ineq.shape[0])])
+    n_eq = eq_rows.shape[0]
+    try:
+        z, _, _, residual = solve_with_inequalities(
+            np.zeros(p + 2 * m),
+            np.eye(p + 2 * m),
+            stacked,
+            rhs,
+            np.arange(n_eq),
+            n_eq + np.arange(ineq.shape[0]),
+        )
+    except SimulationError:
+        return None
+    if residual > 1e-10 * (float(np.linalg.norm(Q)) + 1e-300):
+        return None
+    lam = lam0.copy()
+    lam[rows] = z
+    if equal.size:
+        moved = Q0 - A[rows].T @ z  # in the bilateral rows' span
+        lam[equal] = lam0[equal] + np.linalg.lstsq(A[equal].T, moved, rcond=None)[0]
+    residual_e = float(np.linalg.norm(A[equal] @ acc - b[equal])) if equal.size else 0.0
+    return ac, lam, rank, residual_e
+
+
+def _least_norm_normals(
+    A: FloatArray,
+    b: FloatArray,
+    acc: FloatArray,
+    free: FloatArray,
+    lam: FloatArray,
+    equal: np.ndarray,
+    candidates: np.ndarray,
+) -> FloatArray:
+    """The multipliers ``lam`` with the unilateral ones replaced by the least-norm
+    non-negative ones that give the same constraint force on the rows at zero slack.
+
+    Redundant contact rows (four corners of a face on a plane) leave the normal forces free
+    within a polytope, and the non-negative least squares of the normal problem returns one
+    of its vertices, which may jump from one evaluation to the next; the friction cones
+    depend on these forces, so the friction solve takes the unique least-norm ones instead
+    (a least-distance program: ``min ‖λ_u‖`` s.t. ``Π A_uᵀ λ_u = Π Q``, ``λ_u ≥ 0``, Q the
+    constraint force and Π the projector off the bilateral rows' span)."""
+    if not candidates.size:
+        return lam
+    slack = A[candidates] @ acc - b[candidates]
+    size = float(np.abs(b[candidates]).max(initial=0.0)) + float(
+        np.abs(A[candidates]).max(initial=0.0)
+    ) * (float(np.abs(acc).max(initial=0.0)) + float(np.abs(free).max(initial=0.0)))
+    active = candidates[(lam[candidates] > 0.0) | (slack <= 1e-10 * size)]
+    if not active.size:
+        return lam
+    Q0 = A[candidates].T @ lam[candidates]  # the unilateral rows' share of M ν̇_c
+    Q = Q0
+    A_u = A[active].T  # (n, p)
+    n, p = A_u.shape
+    if equal.size:
+        A_e = A[equal]
+        proj = np.eye(n) - np.linalg.pinv(A_e) @ A_e
+        A_u, Q = proj @ A_u, proj @ Q
+    rows = np.vstack([A_u, np.eye(p)])
+    rhs = np.concatenate([Q, np.zeros(p)])
+    least, _, _, _ = solve_with_inequalities(
+        np.zeros(p), np.eye(p), rows, rhs, np.arange(n), n + np.arange(p)
+    )
+    out = lam.copy()
+    out[candidates] = 0.0
+    out[active] = np.maximum(least, 0.0)
+    if equal.size:
+        moved = Q0 - A[candidates].T @ out[candidates]  # in the bilateral rows' span
+        out[equal] = lam[equal] + np.linalg.lstsq(A[equal].T, moved, rcond=None)[0]
+    return out
+
+
+def _disk_descent(
+    W: FloatArray, r: FloatArray, f0: FloatArray, radius: FloatArray, tol: float
+) -> FloatArray:
+    """Block coordinate descent on ``min ½ fᵀ W f + (r − W f₀)ᵀ f`` over the disks
+    ``‖f_i‖ ≤ radius_i`` (f (p, 2)), from f₀ whose residual ``W f₀ + (r − W f₀)`` is r: each
+    block minimised exactly in turn, sweeps until no block moves by more than ``tol``."""
+    f = f0.astype(float).reshape(-1)
+    res = np.array(r, dtype=float)
+    p = radius.size
+    blocks = [np.linalg.eigh(W[2 * i : 2 * i + 2, 2 * i : 2 * i + 2]) for i in range(p)]
+    for _ in range(_MAX_SWEEPS):
+        moved = 0.0
+        for i in range(p):
+            sl = slice(2 * i, 2 * i + 2)
+            w, U = blocks[i]
+            g = res[sl] - W[sl, sl] @ f[sl]
+            step = _disk_minimiser(w, U, g, float(radius[i])) - f[sl]
+            if step.any():
+                res += W[:, sl] @ step
+                f[sl] += step
+                moved = max(moved, float(np.abs(step).max()))
+        if moved <= tol:
+            break
+    return f.reshape(p, 2)  # at the cap, the staggered iteration's test decides
+
+
+def _disk_minimiser(w: FloatArray, U: FloatArray, g: FloatArray, rho: float) -> FloatArray:
+    """``argmin ½ fᵀ W f + gᵀ f`` over ``‖f‖ ≤ ρ`` for a 2×2 PSD ``W = U diag(w) Uᵀ``: the
+    unconstrained minimiser if it lies in the disk, else ``f = −(W + ν I)⁻¹ g`` on the circle,
+    ν > 0 the root of the secular equation ``1/‖f(ν)‖ = 1/ρ`` (Newton's method from the left,
+    monotone for this concave function; Moré and Sorensen 1983)."""
+    if not rho > 0.0:
+        return np.zeros(2)
+    gp = U.T @ g
+    w = np.maximum(w, 0.0)
+    floor = 8.0 * _EPS * float(w.max(initial=0.0))
+    free = w > floor
+    if not np.any(np.abs(gp[~free]) > 0.0):  # a minimiser exists; the least-norm one
+        fp = np.where(free, -gp / np.where(free, w, 1.0), 0.0)
+        if float(np.hypot(*fp)) <= rho:
+            return np.asarray(U @ fp, dtype=float)
+    g_norm = float(np.hypot(*gp))
+    nu = 0.0 if bool(free.all()) else 1e-12 * g_norm / rho
+    for _ in range(100):
+        d = w + nu
+        n2 = float(np.sum((gp / d) ** 2))
+        n = np.sqrt(n2)
+        psi = 1.0 / n - 1.0 / rho
+        dpsi = float(np.sum(gp**2 / d**3)) / (n2 * n)
+        step = -psi / dpsi
+        nu += step
+        if abs(step) <= 4.0 * _EPS * nu:
+            break
+    fp = -gp / (w + nu)
+    fp *= min(1.0, rho / float(np.hypot(*fp)))
+    return np.asarray(U @ fp, dtype=float)
+
+
 class ContactSolver(DenseSolver):
     """Dense rows with unilateral constraints: the active-set KKT solve (module docstring)."""
 
@@ -168,21 +517,46 @@ class ContactSolver(DenseSolver):
                 f"the constraints gave {b.size} rows at t = {state.t:.9g} s and "
                 f"{ranges[-1][2]} at the start: a constraint's row count may not change"
             )
+        normal, tangent, mu, velocity = [], [], [], []
         for c, r0, r1 in ranges:
             if isinstance(c, UnilateralConstraint):
-                closed = c.closed(state)
-                candidates += [r0 + k for k in np.flatnonzero(closed)]
+                shut = c.closed(state)
+                closed = np.flatnonzero(shut)
+                candidates += [r0 + k for k in closed]
+                if c.friction > 0.0 and closed.size:
+                    k = shut.size
+                    normal += [r0 + i for i in closed]
+                    tangent += [(r0 + k + 2 * i, r0 + k + 2 * i + 1) for i in closed]
+                    mu += [c.friction] * closed.size
+                    velocity.append(c.tangential_velocities(state)[closed])  # type: ignore[attr-defined]
             else:
                 equal += list(range(r0, r1))
-        ac, lam, rank, residual = solve_with_inequalities(
-            a,
-            self._Minv_sqrt,
-            A,
-            b,
-            np.array(equal, dtype=np.int64),
-            np.array(candidates, dtype=np.int64),
-            self.system.rcond,
-        )
+        if normal:
+            ac, lam, rank, residual = solve_with_friction(
+                a,
+                self._Minv_sqrt,
+                A,
+                b,
+                np.array(equal, dtype=np.int64),
+                np.array(candidates, dtype=np.int64),
+                FrictionRows(
+                    np.array(normal, dtype=np.int64),
+                    np.array(tangent, dtype=np.int64),
+                    np.array(mu),
+                    np.concatenate(velocity),
+                ),
+                self.system.rcond,
+            )
+        else:
+            ac, lam, rank, residual = solve_with_inequalities(
+                a,
+                self._Minv_sqrt,
+                A,
+                b,
+                np.array(equal, dtype=np.int64),
+                np.array(candidates, dtype=np.int64),
+                self.system.rcond,
+            )
         scale = float(np.linalg.norm(b)) + float(np.linalg.norm(A)) * (
             float(np.linalg.norm(a)) + float(np.linalg.norm(ac))
         )
@@ -224,7 +598,7 @@ def impulse(system: System, state: State, *, plastic: bool = False) -> tuple[Sta
         n = int(np.asarray(c.rows(state)[1]).reshape(-1).size)
         if isinstance(c, UnilateralConstraint):
             g, gd = c.gaps(state)
-            for k in range(n):
+            for k in range(g.size):  # the normal rows (tangential ones, if any, follow)
                 if g[k] <= CLOSED_GAP:
                     candidates.append(r + k)
                     e = 0.0 if plastic else c.restitution
@@ -462,11 +836,12 @@ def contact_kkt(system: System, trajectory: Trajectory) -> dict[str, ContactKKT]
         if isinstance(c, UnilateralConstraint):
             gaps, slack = [], []
             cols = system.layout.columns(c.bodies)
+            k = c.gaps(first)[0].size  # the normal rows (tangential ones, if any, follow)
             for i, s in enumerate(states):
                 A, b = c.rows(s)
                 gaps.append(c.gaps(s)[0])
-                slack.append(np.asarray(A) @ trajectory.acceleration[i][cols] - b)
-            lam = trajectory.multipliers[:, r : r + n]
+                slack.append(np.asarray(A)[:k] @ trajectory.acceleration[i][cols] - b[:k])
+            lam = trajectory.multipliers[:, r : r + k]
             sl = np.array(slack)
             out[c.name] = ContactKKT(c.name, np.array(gaps), lam, sl, lam * sl)
         r += n
