@@ -599,7 +599,8 @@ def _point_plane_contact(rng: np.random.Generator) -> Case:
 
     body = _bodies(rng)[0]
     points = rng.normal(size=(int(rng.integers(1, 5)), 3))
-    c = PointPlaneContact(body, points, normal=_direction(rng), height=rng.normal())
+    mu = float(rng.uniform(0.0, 1.0)) if rng.integers(0, 2) else 0.0  # with friction or not
+    c = PointPlaneContact(body, points, normal=_direction(rng), height=rng.normal(), friction=mu)
     return _case(rng, c, (body,), (0.0, 10.0), 1.0)
 
 
