@@ -600,9 +600,9 @@ def simulate_pulsed(
         frame) at the period's start.
     period : float
         The control period Δt (s, > 0).
-    t_eval : array_like, optional
-        Output times; default every accepted step (one output per time: the state after a
-        switch).
+    t_eval : array_like, shape (k,), optional
+        Output times (s); default every accepted step (one output per time: the state after
+        a switch).
     weights : array_like (6,), optional
         Allocation weights (:meth:`ThrusterSet.allocate`).
     **options
