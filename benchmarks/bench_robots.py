@@ -129,6 +129,75 @@ def panda_run(repeat: int) -> None:
           f"({t_p / n_p * 1e6:.1f} µs each)")  # fmt: skip
 
 
+def breakdown(repeat: int) -> None:
+    """Where one evaluation's time goes (compiled pieces timed in a compiled loop of 200 calls,
+    as the step loop calls them; Python pieces as ``accelerations`` calls them)."""
+    from numba import njit
+
+    from gmuk.robots.joints import joint_rows
+
+    @njit
+    def rows_loop(gp, Vp, gc, Vc, p, A, b, k):
+        for _ in range(k):
+            joint_rows(0.0, gp, Vp, gc, Vc, p, A, b)
+
+    @njit
+    def solve_loop(kernel, V, Q, A, b, P, out, k):
+        for _ in range(k):
+            kernel(V, Q, A, b, P, out)
+
+    print("one evaluation, piece by piece (medians; compiled pieces per call in a compiled loop)")
+    for name, (path, base, locked) in ROBOTS.items():
+        _pieces(name, path, base, locked, repeat, rows_loop, solve_loop)
+
+
+def _pieces(name, path, base, locked, repeat, rows_loop, solve_loop) -> None:
+    from gmuk.engine._uk_kernels import uk_rigid
+    from gmuk.engine.tree import tree_rigid
+
+    robots = {
+        s: Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked, solver=s)
+        for s in SOLVERS
+    }
+    tree, fused = robots["tree"], robots["fused"]
+    pin.seed(0)
+    model = tree.model
+    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+    v = np.random.default_rng(0).normal(size=model.nv)
+    state = tree.state(q, v)
+    sys_t = tree.system
+    modeled = np.array(sys_t._generalized_forces(state)[0])
+    A, b = sys_t.solver._blocks(state)
+    V = np.array(state.V)
+    n = V.size
+    out = np.empty(4 * n + b.size + 3)
+    args = []
+    for j in tree.joints.values():
+        s = j._T.shape[0]
+        args.append((*(np.array(x) for x in j._pair(state)), j._params, np.empty((s, 12)),
+                     np.empty(s)))  # fmt: skip
+    for a in args:
+        rows_loop(*a, 1)
+    t_rows = _median_s(lambda: [rows_loop(*a, 200) for a in args], repeat, 1) / 200
+    P = sys_t.solver._P
+    solve_loop(tree_rigid, V, modeled, A, b, P, out, 1)
+    t_tree = _median_s(lambda: solve_loop(tree_rigid, V, modeled, A, b, P, out, 200), repeat, 1)
+    sys_f = fused.system
+    Af, bf = sys_f._stack_rows(fused.state(q, v), check_finite=False)
+    Af = np.ascontiguousarray(Af)
+    out_f = np.empty(4 * n + bf.size + 3)
+    Pf = sys_f.solver._params
+    solve_loop(uk_rigid, V, modeled, Af, bf, Pf, out_f, 1)
+    t_qr = _median_s(lambda: solve_loop(uk_rigid, V, modeled, Af, bf, Pf, out_f, 200), repeat, 1)
+    t_loads = _median_s(lambda: sys_t._generalized_forces(state), repeat, 50)
+    t_blocks = _median_s(lambda: sys_t.solver._blocks(state), repeat, 50)
+    note = " (beyond its 48-row QR)" if bf.size > 48 else ""
+    print(f"  {name:7s}: joint rows (all {len(args)} kernels) {t_rows * 1e6:6.1f} µs, "
+          f"tree solve {t_tree / 200 * 1e6:6.1f} µs, fused dense QR "
+          f"{t_qr / 200 * 1e6:7.1f} µs{note}; in Python: loads {t_loads * 1e6:6.1f} µs, "
+          f"rows {t_blocks * 1e6:6.1f} µs")  # fmt: skip
+
+
 def chain(n: int, solver: str | None = None) -> tuple[gmuk.System, gmuk.State]:
     links = [gmuk.RigidBody(f"l{i}", 1.0, np.diag([0.01, 0.09, 0.09])) for i in range(n)]
     half = np.eye(4)
@@ -198,11 +267,13 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--sizes", default="5,10,20,40,80,160,320,640,1000")
     parser.add_argument("--dense-max", type=int, default=40)
-    parser.add_argument("--only", default="call,run,chain", help="which measurements")
+    parser.add_argument("--only", default="call,parts,run,chain", help="which measurements")
     args = parser.parse_args(argv)
     only = set(args.only.split(","))
     if "call" in only:
         one_call(args.repeat)
+    if "parts" in only:
+        breakdown(args.repeat)
     if "run" in only:
         panda_run(args.repeat)
     if "chain" in only:
