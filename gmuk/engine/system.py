@@ -18,6 +18,7 @@ import functools
 import inspect
 import itertools
 import math
+import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Literal, ParamSpec, TypeVar
 
@@ -98,10 +99,13 @@ class System:
     controllers : sequence of Controller
     solver : str or UKSolver subclass, optional
         The Udwadia–Kalaba solve strategy (:mod:`gmuk.engine.solvers`): "fused", "dense",
-        "sparse", "eq80", or any registered name or subclass. Default: chosen from
-        ``sparse`` and ``tangent_bundle_method`` — "eq80" when asked for, "sparse" when
-        ``sparse`` is True (or "auto" above ``SPARSE_THRESHOLD`` dof), else "fused" when the
-        System allows it (rigid bodies only, every load modeled), else "dense".
+        "sparse", "tree", "eq80", or any registered name or subclass. Default: chosen from
+        ``sparse`` and ``tangent_bundle_method`` — "eq80" when asked for, "tree" (linear
+        time, :mod:`gmuk.engine.tree`) when ``sparse`` is "auto" and every constraint is a
+        :mod:`gmuk.robots` joint, the joints forming a tree or forest with the ground,
+        "sparse" when ``sparse`` is True (or "auto" above ``SPARSE_THRESHOLD`` dof), else
+        "fused" when the System allows it (rigid bodies only, every load modeled), else
+        "dense".
     sparse : {"auto", True, False}
         Sparse or dense rows and mass blocks when ``solver`` is not given.
     sparse_solver : {"lu", "cg"}
@@ -237,6 +241,8 @@ class System:
             from gmuk.engine.contact import ContactSolver  # the contact solve (its own module)
 
             cls = ContactSolver
+        elif sparse == "auto" and self._joint_tree():
+            cls = TreeSolver
         elif sparse is True or (sparse == "auto" and self.layout.n_dof > SPARSE_THRESHOLD):
             cls = solvers.SparseSolver
         elif not solvers.FusedRigidSolver.problems(self):
@@ -247,6 +253,16 @@ class System:
         if problems:
             raise DefinitionError(problems)
         return cls
+
+    def _joint_tree(self) -> bool:
+        """Whether every constraint is a joint of :mod:`gmuk.robots` and they form a tree or
+        forest with the ground (what the tree solve takes, :class:`TreeSolver`)."""
+        joints = sys.modules.get("gmuk.robots.joints")  # no joint unless that is imported
+        if joints is None or not self.constraints:
+            return False
+        if not all(isinstance(c, joints.Joint) for c in self.constraints):
+            return False
+        return not TreeSolver.problems(self)
 
     @property
     def tangent_bundle(self) -> bool:
