@@ -36,7 +36,6 @@ from gmuk._numba import njit
 from gmuk._validation import FloatArray, as_array, check_se3, real_number
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import Baumgarte, Constraint
-from gmuk.constraints.relative import relative_rows
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3
 from gmuk.lie._kernels import _se3_exp, _se3_log_into
@@ -68,146 +67,208 @@ _CONSTANT, _UNIVERSAL, _SCREW = 0, 1, 2
 _HEAD = 3 + 16 + 16 + 36 + 36
 
 
+@njit(cache=True, inline="always")
+def _frame_row(g, i, p, o):  # type: ignore[no-untyped-def]
+    """Row i of g X, the rotation's three entries then the translation's (4-tuple), for the
+    rigid transform g (4, 4) and X (4, 4) stored row by row at ``p[o : o + 16]``."""
+    a0, a1, a2 = g[i, 0], g[i, 1], g[i, 2]
+    return (
+        a0 * p[o] + a1 * p[o + 4] + a2 * p[o + 8],
+        a0 * p[o + 1] + a1 * p[o + 5] + a2 * p[o + 9],
+        a0 * p[o + 2] + a1 * p[o + 6] + a2 * p[o + 10],
+        a0 * p[o + 3] + a1 * p[o + 7] + a2 * p[o + 11] + g[i, 3],
+    )
+
+
+@njit(cache=True, inline="always")
+def _stored_row(p, i, o):  # type: ignore[no-untyped-def]
+    """Row i of the (4, 4) matrix stored row by row at ``p[o : o + 16]`` (4-tuple)."""
+    return p[o + 4 * i], p[o + 4 * i + 1], p[o + 4 * i + 2], p[o + 4 * i + 3]
+
+
+@njit(cache=True, inline="always")
+def _dot6(p, o, V):  # type: ignore[no-untyped-def]
+    """``p[o : o + 6] · V``."""
+    return (
+        p[o] * V[0] + p[o + 1] * V[1] + p[o + 2] * V[2]
+        + p[o + 3] * V[3] + p[o + 4] * V[4] + p[o + 5] * V[5]
+    )  # fmt: skip
+
+
+@njit(cache=True, inline="always")
+def _apply(p, o, V):  # type: ignore[no-untyped-def]
+    """Ad V (6-tuple) for Ad (6, 6) stored row by row at ``p[o : o + 36]``."""
+    return (
+        _dot6(p, o, V), _dot6(p, o + 6, V), _dot6(p, o + 12, V),
+        _dot6(p, o + 18, V), _dot6(p, o + 24, V), _dot6(p, o + 30, V),
+    )  # fmt: skip
+
+
+@njit(cache=True, inline="always")
+def _h_row(P0, P1, P2, C0, C1, C2, i):  # type: ignore[no-untyped-def]
+    """Row i of h = g_Jp⁻¹ g_Jc (4-tuple) from the rows of g_Jp (P) and g_Jc (C)."""
+    return (
+        P0[i] * C0[0] + P1[i] * C1[0] + P2[i] * C2[0],
+        P0[i] * C0[1] + P1[i] * C1[1] + P2[i] * C2[1],
+        P0[i] * C0[2] + P1[i] * C1[2] + P2[i] * C2[2],
+        P0[i] * (C0[3] - P0[3]) + P1[i] * (C1[3] - P1[3]) + P2[i] * (C2[3] - P2[3]),
+    )
+
+
+@njit(cache=True, inline="always")
+def _column_dot(x, p, o, j):  # type: ignore[no-untyped-def]
+    """``x · M[:, j]`` for a 6-tuple x and M (6, 6) stored row by row at ``p[o : o + 36]``."""
+    return (
+        x[0] * p[o + j] + x[1] * p[o + 6 + j] + x[2] * p[o + 12 + j]
+        + x[3] * p[o + 18 + j] + x[4] * p[o + 24 + j] + x[5] * p[o + 30 + j]
+    )  # fmt: skip
+
+
 @njit(cache=True)
-def _unpack(g1, V1, g2, V2, p):  # type: ignore[no-untyped-def]
-    """The joint frames' poses and twists (g_Jp, V_Jp, g_Jc, V_Jc) from the bodies'."""
-    XP = p[3:19].reshape(4, 4)
-    XC = p[19:35].reshape(4, 4)
-    AdP = p[35:71].reshape(6, 6)
-    AdC = p[71:107].reshape(6, 6)
+def _joint_state(g1, V1, g2, V2, p):  # type: ignore[no-untyped-def]
+    """The relative pose h = g_Jp⁻¹ g_Jc (its three rows, 4-tuples), the translation q of
+    h⁻¹ (3-tuple), the twists
+    W = Ad_{h⁻¹} V_Jp (J_p's twist in J_c) and V_rel = V_Jc − W (6-tuples), and a₁ = R_hᵀ a₁ᵖ
+    (a universal joint's first axis in J_c; zero for another kind), with no array built."""
     if p[0] != 0.0:  # to the ground: J_p is fixed in N
-        gJp = XP.copy()
-        VJp = np.zeros(6)
-        gJc = g1 @ XC
-        VJc = AdC @ V1
+        P0, P1, P2 = _stored_row(p, 0, 3), _stored_row(p, 1, 3), _stored_row(p, 2, 3)
+        VJp = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        C0, C1, C2 = _frame_row(g1, 0, p, 19), _frame_row(g1, 1, p, 19), _frame_row(g1, 2, p, 19)
+        VJc = _apply(p, 71, V1)
     else:
-        gJp = g1 @ XP
-        VJp = AdP @ V1
-        gJc = g2 @ XC
-        VJc = AdC @ V2
-    return gJp, VJp, gJc, VJc, AdP, AdC
-
-
-@njit(cache=True)
-def _relative_pose(gJp, gJc):  # type: ignore[no-untyped-def]
-    """h = g_Jp⁻¹ g_Jc."""
-    h = np.zeros((4, 4))
-    for i in range(3):
-        for j in range(3):
-            h[i, j] = gJp[0, i] * gJc[0, j] + gJp[1, i] * gJc[1, j] + gJp[2, i] * gJc[2, j]
-        h[i, 3] = (
-            gJp[0, i] * (gJc[0, 3] - gJp[0, 3])
-            + gJp[1, i] * (gJc[1, 3] - gJp[1, 3])
-            + gJp[2, i] * (gJc[2, 3] - gJp[2, 3])
-        )
-    h[3, 3] = 1.0
-    return h
-
-
-@njit(cache=True)
-def _rows_matrix(p, h):  # type: ignore[no-untyped-def]
-    """The constraint rows T (s, 6) at relative pose h, and for a universal joint the
-    direction n = a₁ × a₂ (a₁ = R_hᵀ a₁ᵖ, in J_c) of its rotation row."""
-    s = int(p[2])
-    T = p[_HEAD : _HEAD + 6 * s].reshape(s, 6).copy()
-    n = np.zeros(3)
-    a1 = np.zeros(3)
+        P0, P1, P2 = _frame_row(g1, 0, p, 3), _frame_row(g1, 1, p, 3), _frame_row(g1, 2, p, 3)
+        VJp = _apply(p, 35, V1)
+        C0, C1, C2 = _frame_row(g2, 0, p, 19), _frame_row(g2, 1, p, 19), _frame_row(g2, 2, p, 19)
+        VJc = _apply(p, 71, V2)
+    h0 = _h_row(P0, P1, P2, C0, C1, C2, 0)
+    h1 = _h_row(P0, P1, P2, C0, C1, C2, 1)
+    h2 = _h_row(P0, P1, P2, C0, C1, C2, 2)
+    # Ad_{h⁻¹} = [[R_hᵀ, 0], [q^ R_hᵀ, R_hᵀ]], q = R_Jcᵀ (p_Jp − p_Jc) the translation of h⁻¹
+    q0 = C0[0] * (P0[3] - C0[3]) + C1[0] * (P1[3] - C1[3]) + C2[0] * (P2[3] - C2[3])
+    q1 = C0[1] * (P0[3] - C0[3]) + C1[1] * (P1[3] - C1[3]) + C2[1] * (P2[3] - C2[3])
+    q2 = C0[2] * (P0[3] - C0[3]) + C1[2] * (P1[3] - C1[3]) + C2[2] * (P2[3] - C2[3])
+    x0 = h0[0] * VJp[0] + h1[0] * VJp[1] + h2[0] * VJp[2]  # R_hᵀ ω_Jp
+    x1 = h0[1] * VJp[0] + h1[1] * VJp[1] + h2[1] * VJp[2]
+    x2 = h0[2] * VJp[0] + h1[2] * VJp[1] + h2[2] * VJp[2]
+    y0 = h0[0] * VJp[3] + h1[0] * VJp[4] + h2[0] * VJp[5] + (q1 * x2 - q2 * x1)
+    y1 = h0[1] * VJp[3] + h1[1] * VJp[4] + h2[1] * VJp[5] + (q2 * x0 - q0 * x2)
+    y2 = h0[2] * VJp[3] + h1[2] * VJp[4] + h2[2] * VJp[5] + (q0 * x1 - q1 * x0)
+    W = (x0, x1, x2, y0, y1, y2)
+    Vr = (VJc[0] - x0, VJc[1] - x1, VJc[2] - x2, VJc[3] - y0, VJc[4] - y1, VJc[5] - y2)
+    a1 = (0.0, 0.0, 0.0)
     if p[1] == _UNIVERSAL:
+        e = _HEAD + 8 * int(p[2])
+        a1 = (
+            h0[0] * p[e] + h1[0] * p[e + 1] + h2[0] * p[e + 2],
+            h0[1] * p[e] + h1[1] * p[e + 1] + h2[1] * p[e + 2],
+            h0[2] * p[e] + h1[2] * p[e + 1] + h2[2] * p[e + 2],
+        )
+    return h0, h1, h2, (q0, q1, q2), W, Vr, a1
+
+
+@njit(cache=True, inline="always")
+def _row_entry(p, s, a1, i, k):  # type: ignore[no-untyped-def]
+    """T[i, k]: the stored rows, but for a universal joint's last row [n; 0], n = a₁ × a₂."""
+    if p[1] == _UNIVERSAL and i == s - 1:
+        if k >= 3:
+            return 0.0
         e = _HEAD + 8 * s
-        for i in range(3):
-            a1[i] = h[0, i] * p[e] + h[1, i] * p[e + 1] + h[2, i] * p[e + 2]
-        a2 = p[e + 3 : e + 6]
-        n[0] = a1[1] * a2[2] - a1[2] * a2[1]
-        n[1] = a1[2] * a2[0] - a1[0] * a2[2]
-        n[2] = a1[0] * a2[1] - a1[1] * a2[0]
-        for k in range(3):
-            T[s - 1, k] = n[k]
-            T[s - 1, 3 + k] = 0.0
-    return T, n, a1
+        if k == 0:
+            return a1[1] * p[e + 5] - a1[2] * p[e + 4]
+        if k == 1:
+            return a1[2] * p[e + 3] - a1[0] * p[e + 5]
+        return a1[0] * p[e + 4] - a1[1] * p[e + 3]
+    return p[_HEAD + 6 * i + k]
+
+
+@njit(cache=True, inline="always")
+def _row_dot(p, s, a1, i, x):  # type: ignore[no-untyped-def]
+    """``T[i] · x`` for a 6-tuple x."""
+    acc = 0.0
+    for k in range(6):
+        acc += _row_entry(p, s, a1, i, k) * x[k]
+    return acc
 
 
 @njit(cache=True)
-def _position_residual(p, h, T, a1):  # type: ignore[no-untyped-def]
-    """Φ (s,): zero exactly when the joint holds, with Φ̇ = T V_rel to first order."""
-    s = int(p[2])
-    xi = np.empty((1, 6))
-    hh = np.empty((1, 4, 4))
-    hh[0] = h
-    if p[1] == _SCREW:  # unscrew by the turn its slide implies: h exp(−θ_d S)
-        e = _HEAD + 8 * s
-        axis = p[e : e + 3]
+def _log_residual(p, h0, h1, h2, scratch):  # type: ignore[no-untyped-def]
+    """log(h) (6-tuple) from the rows of h, or for a screw joint log(h exp(−θ_d S)), unscrewed
+    by the turn θ_d = a·p_h / pitch its slide implies. ``scratch`` (≥ 44 float64,
+    C-contiguous) holds the arrays that the exponential and the log take."""
+    hh = scratch[0:16].reshape((1, 4, 4))
+    xi = scratch[16:22].reshape((1, 6))
+    for j in range(4):
+        hh[0, 0, j], hh[0, 1, j], hh[0, 2, j], hh[0, 3, j] = h0[j], h1[j], h2[j], 0.0
+    hh[0, 3, 3] = 1.0
+    if p[1] == _SCREW:
+        e = _HEAD + 8 * int(p[2])
         pitch = p[e + 3]
-        slide = axis[0] * h[0, 3] + axis[1] * h[1, 3] + axis[2] * h[2, 3]
-        theta = slide / pitch
-        back = np.empty(6)
+        theta = (p[e] * h0[3] + p[e + 1] * h1[3] + p[e + 2] * h2[3]) / pitch
+        back = scratch[22:28]
+        u = scratch[28:44].reshape((4, 4))
         for k in range(3):
-            back[k] = -theta * axis[k]
-            back[3 + k] = -theta * pitch * axis[k]
-        u = np.empty((4, 4))
+            back[k] = -theta * p[e + k]
+            back[3 + k] = -theta * pitch * p[e + k]
         _se3_exp(back, u)
-        hh[0] = h @ u
+        for i in range(3):
+            r = h0 if i == 0 else (h1 if i == 1 else h2)
+            for j in range(4):
+                hh[0, i, j] = r[0] * u[0, j] + r[1] * u[1, j] + r[2] * u[2, j]
+            hh[0, i, 3] += r[3]
     _se3_log_into(hh, xi)
-    phi = T @ xi[0]
-    if p[1] == _UNIVERSAL:  # −a₁·a₂, whose rate is n·ω_rel
+    return xi[0, 0], xi[0, 1], xi[0, 2], xi[0, 3], xi[0, 4], xi[0, 5]
+
+
+@njit(cache=True, inline="always")
+def _position_residual(p, s, a1, i, xi):  # type: ignore[no-untyped-def]
+    """Φ_i: zero exactly when the joint holds, with Φ̇ = T V_rel to first order: ``T[i] · ξ``
+    (ξ from :func:`_log_residual`), and for a universal joint's last row −a₁·a₂, whose rate
+    is n·ω_rel."""
+    if p[1] == _UNIVERSAL and i == s - 1:
         e = _HEAD + 8 * s
-        phi[s - 1] = -(a1[0] * p[e + 3] + a1[1] * p[e + 4] + a1[2] * p[e + 5])
-    return phi
+        return -(a1[0] * p[e + 3] + a1[1] * p[e + 4] + a1[2] * p[e + 5])
+    return _row_dot(p, s, a1, i, xi)
 
 
 @njit(cache=True)
 def joint_residuals(g1, V1, g2, V2, p, pos, vel):  # type: ignore[no-untyped-def]
     """A joint's position residual Φ (s,) and velocity residual T V_rel (s,), written into
     ``pos`` and ``vel`` (module docstring; p packed by :meth:`Joint._kernel_params`)."""
-    gJp, VJp, gJc, VJc, _, _ = _unpack(g1, V1, g2, V2, p)
-    h = _relative_pose(gJp, gJc)
-    T, _, a1 = _rows_matrix(p, h)
-    Ad_h_inv = se3_Ad_inverse(h)
-    Vr = VJc - Ad_h_inv @ VJp
-    pos[:] = _position_residual(p, h, T, a1)
-    vel[:] = T @ Vr
-
-
-@njit(cache=True)
-def se3_Ad_inverse(h):  # type: ignore[no-untyped-def]
-    """Ad_{h⁻¹} = [[Rᵀ, 0], [−Rᵀ p^, Rᵀ]] (6, 6) for h = (R, p)."""
-    out = np.zeros((6, 6))
-    p0, p1, p2 = h[0, 3], h[1, 3], h[2, 3]
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = h[j, i]
-            out[3 + i, 3 + j] = h[j, i]
-    P = np.array([[0.0, -p2, p1], [p2, 0.0, -p0], [-p1, p0, 0.0]])
-    for i in range(3):
-        for j in range(3):
-            acc = 0.0
-            for k in range(3):
-                acc += h[k, i] * P[k, j]
-            out[3 + i, j] = -acc
-    return out
+    s = int(p[2])
+    h0, h1, h2, _q, _W, Vr, a1 = _joint_state(g1, V1, g2, V2, p)
+    xi = _log_residual(p, h0, h1, h2, np.empty(44))
+    for i in range(s):
+        pos[i] = _position_residual(p, s, a1, i, xi)
+        vel[i] = _row_dot(p, s, a1, i, Vr)
 
 
 @njit(cache=True)
 def joint_rows(t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
     """The rows of a joint into A (s, 12) and b (s,): columns [V_P, V_C] (a joint to the
-    ground: [V_C, 0]); ``T V̇_rel = −α T V_rel − β Φ`` (module docstring). Returns 0."""
+    ground: [V_C, 0]); ``T V̇_rel = −α T V_rel − β Φ`` (module docstring). Returns 0.
+
+    The rows of a relative constraint between the joint frames (the math of
+    :func:`gmuk.constraints.relative.relative_rows` with a_des = 0),
+    ``[−T Ad_{h⁻¹}, T]`` and ``T r`` with ``r = −ad_{V_rel} W``, ``W = Ad_{h⁻¹} V_Jp``, mapped
+    to the bodies' twists by ``Ad_{X_PJ⁻¹}`` and ``Ad_{X_CJ⁻¹}``. Written entry by entry into
+    A and b with no array allocated: A serves as scratch for the log of the position residual
+    before its rows are written (12 s ≥ 36 entries; ≥ 44 for the screw joint's s = 5)."""
     s = int(p[2])
-    gJp, VJp, gJc, VJc, AdP, AdC = _unpack(g1, V1, g2, V2, p)
-    h = _relative_pose(gJp, gJc)
-    T, _n, a1 = _rows_matrix(p, h)
-    At = np.empty((s, 12))
-    bt = np.empty(s)
-    Vr = np.empty(6)
-    relative_rows(gJp, VJp, gJc, VJc, T, np.zeros(6), At, bt, Vr)
-    child = np.ascontiguousarray(At[:, 6:]) @ AdC
-    if p[0] != 0.0:
-        A[:, :6] = child
-        A[:, 6:] = 0.0
-    else:
-        A[:, :6] = np.ascontiguousarray(At[:, :6]) @ AdP
-        A[:, 6:] = child
+    h0, h1, h2, q, W, Vr, a1 = _joint_state(g1, V1, g2, V2, p)
+    w0, w1, w2, v0, v1, v2 = Vr
+    x0, x1, x2, y0, y1, y2 = W
+    r = (
+        -(w1 * x2 - w2 * x1),
+        -(w2 * x0 - w0 * x2),
+        -(w0 * x1 - w1 * x0),
+        -(v1 * x2 - v2 * x1 + w1 * y2 - w2 * y1),
+        -(v2 * x0 - v0 * x2 + w2 * y0 - w0 * y2),
+        -(v0 * x1 - v1 * x0 + w0 * y1 - w1 * y0),
+    )
+    for i in range(s):
+        b[i] = _row_dot(p, s, a1, i, r)
     if p[1] == _UNIVERSAL:  # d/dt (n·ω_rel) = n·ω̇_rel + ṅ·ω_rel, ṅ = (−ω_rel × a₁) × a₂
         e = _HEAD + 8 * s
-        w0, w1, w2 = Vr[0], Vr[1], Vr[2]
         d0 = -(w1 * a1[2] - w2 * a1[1])
         d1 = -(w2 * a1[0] - w0 * a1[2])
         d2 = -(w0 * a1[1] - w1 * a1[0])
@@ -215,19 +276,44 @@ def joint_rows(t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
         nd0 = d1 * q2 - d2 * q1
         nd1 = d2 * q0 - d0 * q2
         nd2 = d0 * q1 - d1 * q0
-        bt[s - 1] -= nd0 * w0 + nd1 * w1 + nd2 * w2
-    alpha = p[_HEAD + 6 * s : _HEAD + 7 * s]
-    beta = p[_HEAD + 7 * s : _HEAD + 8 * s]
+        b[s - 1] -= nd0 * w0 + nd1 * w1 + nd2 * w2
+    ga = _HEAD + 6 * s  # the gains α (s), then β (s)
     stabilised = False
     for i in range(s):
-        if alpha[i] != 0.0 or beta[i] != 0.0:
+        if p[ga + i] != 0.0 or p[ga + s + i] != 0.0:
             stabilised = True
     if stabilised:
-        phi = _position_residual(p, h, T, a1)
-        vel = T @ Vr
+        xi = _log_residual(p, h0, h1, h2, A.reshape(A.size))
         for i in range(s):
-            bt[i] -= alpha[i] * vel[i] + beta[i] * phi[i]
-    b[:] = bt
+            vel = _row_dot(p, s, a1, i, Vr)
+            phi = _position_residual(p, s, a1, i, xi)
+            b[i] -= p[ga + i] * vel + p[ga + s + i] * phi
+    grounded = p[0] != 0.0
+    for i in range(s):
+        T = (
+            _row_entry(p, s, a1, i, 0), _row_entry(p, s, a1, i, 1), _row_entry(p, s, a1, i, 2),
+            _row_entry(p, s, a1, i, 3), _row_entry(p, s, a1, i, 4), _row_entry(p, s, a1, i, 5),
+        )  # fmt: skip
+        if grounded:
+            for j in range(6):
+                A[i, j] = _column_dot(T, p, 71, j)  # T Ad_{X_CJ⁻¹}
+                A[i, 6 + j] = 0.0
+            continue
+        # u = T[i] Ad_{h⁻¹}: u_k = (T_ω + T_v × q) · (row k of R_h), u_{3+k} = T_v · (row k)
+        z0 = T[0] + (T[4] * q[2] - T[5] * q[1])
+        z1 = T[1] + (T[5] * q[0] - T[3] * q[2])
+        z2 = T[2] + (T[3] * q[1] - T[4] * q[0])
+        u = (
+            z0 * h0[0] + z1 * h0[1] + z2 * h0[2],
+            z0 * h1[0] + z1 * h1[1] + z2 * h1[2],
+            z0 * h2[0] + z1 * h2[1] + z2 * h2[2],
+            T[3] * h0[0] + T[4] * h0[1] + T[5] * h0[2],
+            T[3] * h1[0] + T[4] * h1[1] + T[5] * h1[2],
+            T[3] * h2[0] + T[4] * h2[1] + T[5] * h2[2],
+        )
+        for j in range(6):
+            A[i, j] = -_column_dot(u, p, 35, j)  # −T Ad_{h⁻¹} Ad_{X_PJ⁻¹}
+            A[i, 6 + j] = _column_dot(T, p, 71, j)  # T Ad_{X_CJ⁻¹}
     return 0
 
 

@@ -14,6 +14,7 @@ import pytest
 from scipy.special import ellipk
 
 import gmuk
+from gmuk.constraints.relative import relative_rows
 from gmuk.errors import DefinitionError, NotOnGroupError
 from gmuk.lie import se3, so3
 from gmuk.robots import (
@@ -28,6 +29,7 @@ from gmuk.robots import (
     SphericalJoint,
     UniversalJoint,
 )
+from gmuk.robots.joints import _HEAD, _SCREW, _UNIVERSAL, joint_residuals, joint_rows
 
 
 def _inertia(rng: np.random.Generator) -> np.ndarray:
@@ -332,3 +334,82 @@ def test_bad_joint_definitions_say_what_is_wrong():
         JointSpringDamper(hinge, stiffness=-1.0)
     with pytest.raises(DefinitionError, match=r"1 numbers|number"):
         JointSpringDamper(hinge, damping=[1.0, 2.0])
+
+
+# -- the compiled row kernel against a straightforward reference: the joint frames' poses and
+# twists by matrix products, the rows of a relative constraint between them (relative_rows),
+# mapped to the bodies' twists, the universal joint's moving row and the Baumgarte terms with
+# the position residual by se3.log
+
+
+def _reference(g1, V1, g2, V2, p):
+    """(A (s, 12), b (s,), Φ (s,), T V_rel (s,)) by the matrix products of the joint's math."""
+    s = int(p[2])
+    XP, XC = p[3:19].reshape(4, 4), p[19:35].reshape(4, 4)
+    AdP, AdC = p[35:71].reshape(6, 6), p[71:107].reshape(6, 6)
+    if p[0] != 0.0:
+        gJp, VJp, gJc, VJc = XP, np.zeros(6), g1 @ XC, AdC @ V1
+    else:
+        gJp, VJp, gJc, VJc = g1 @ XP, AdP @ V1, g2 @ XC, AdC @ V2
+    h = np.linalg.inv(gJp) @ gJc
+    T = p[_HEAD : _HEAD + 6 * s].reshape(s, 6).copy()
+    e = _HEAD + 8 * s
+    a1 = h[:3, :3].T @ p[e : e + 3]
+    if p[1] == _UNIVERSAL:
+        T[-1] = np.concatenate([np.cross(a1, p[e + 3 : e + 6]), np.zeros(3)])
+    At, bt, Vr = np.empty((s, 12)), np.empty(s), np.empty(6)
+    relative_rows(gJp, VJp, gJc, VJc, T, np.zeros(6), At, bt, Vr)
+    A = np.zeros((s, 12))
+    if p[0] != 0.0:
+        A[:, :6] = At[:, 6:] @ AdC
+    else:
+        A[:, :6], A[:, 6:] = At[:, :6] @ AdP, At[:, 6:] @ AdC
+    if p[1] == _UNIVERSAL:
+        n_dot = np.cross(-np.cross(Vr[:3], a1), p[e + 3 : e + 6])
+        bt[-1] -= n_dot @ Vr[:3]
+    hh = h
+    if p[1] == _SCREW:
+        axis, pitch = p[e : e + 3], p[e + 3]
+        theta = axis @ h[:3, 3] / pitch
+        hh = h @ se3.exp(-theta * np.concatenate([axis, pitch * axis])[None])[0]
+    phi = T @ se3.log(hh[None])[0]
+    if p[1] == _UNIVERSAL:
+        phi[-1] = -(a1 @ p[e + 3 : e + 6])
+    vel = T @ Vr
+    alpha, beta = p[_HEAD + 6 * s : _HEAD + 7 * s], p[_HEAD + 7 * s : _HEAD + 8 * s]
+    return A, bt - alpha * vel - beta * phi, phi, vel
+
+
+def _close(new, ref):
+    """Each row equal to round-off: within 1e-13 of the row's largest entry."""
+    scale = np.maximum(np.abs(ref).max(axis=-1, keepdims=True), 1e-300)
+    assert np.all(np.abs(new - ref) <= 1e-13 * scale), np.abs(new - ref).max()
+
+
+@pytest.mark.parametrize("stabilised", [False, True])
+@pytest.mark.parametrize("grounded", [False, True])
+@pytest.mark.parametrize("kind", KINDS)
+def test_joint_rows_equal_the_matrix_product_reference(kind, grounded, stabilised):
+    rng = np.random.default_rng([KINDS.index(kind), grounded, stabilised])
+    for _ in range(20):
+        parent = None if grounded else gmuk.RigidBody("P", 1.0, _inertia(rng))
+        child = gmuk.RigidBody("C", 2.0, _inertia(rng))
+        gains = (
+            gmuk.Baumgarte(alpha=rng.uniform(1, 10), beta=rng.uniform(1, 50))
+            if stabilised
+            else None
+        )
+        joint = _make(kind, parent, child, rng, baumgarte=gains)
+        p = joint._params
+        s = joint._T.shape[0]
+        g1, g2 = _pose(rng, 2.0), _pose(rng, 2.0)
+        V1, V2 = rng.normal(size=6), rng.normal(size=6)
+        A, b = np.full((s, 12), np.nan), np.full(s, np.nan)
+        assert joint_rows(0.0, g1, V1, g2, V2, p, A, b) == 0
+        A_ref, b_ref, phi_ref, vel_ref = _reference(g1, V1, g2, V2, p)
+        _close(A, A_ref)
+        _close(b[None], b_ref[None])
+        pos, vel = np.empty(s), np.empty(s)
+        joint_residuals(g1, V1, g2, V2, p, pos, vel)
+        _close(pos[None], phi_ref[None])
+        _close(vel[None], vel_ref[None])
