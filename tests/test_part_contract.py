@@ -8,7 +8,8 @@ none) and have a factory of random valid instances here. Then, at 100 random sta
 * its Python form (``wrenches``, ``control``, ``rows``/``value``) runs and is finite;
 * a declared compiled form exists for the case and gives the Python numbers: the kernel of
   ``_compiled_term`` is called through its address with the compiled loop's own callers
-  (``_call_force``, ``_call_control``, ``_call_rows``) and the parameters of
+  (``_call_force``, ``_call_control``; ``gmuk.engine.tree._call_rows`` for constraint rows,
+  which the loop's dense rows and tree blocks both call) and the parameters of
   ``_compiled_term``, arguments laid out as the compiled loop lays them out;
 * a declared symbolic form exists and gives the Python numbers when evaluated on numbers
   (CasADi ``DM``): force models through ``gmuk.optimize.parts.force_terms``, inequalities
@@ -50,7 +51,8 @@ from gmuk._forms import FORMS, Forms
 from gmuk._numba import kernel_address
 from gmuk.constraints.base import ROWS_KERNEL, Constraint
 from gmuk.control.base import CONTROL_KERNEL, Controller
-from gmuk.engine.integrators._compiled import _call_control, _call_force, _call_rows
+from gmuk.engine.integrators._compiled import _call_control, _call_force
+from gmuk.engine.tree import _call_rows
 from gmuk.errors import DefinitionError
 from gmuk.forces.base import FORCE_KERNEL, ForceModel
 from gmuk.lie import se3, so3

@@ -477,6 +477,35 @@ _call_rows = kernel_caller(ROWS_KERNEL, "constraint")
 
 
 @njit(cache=True)
+def kernel_rows(t, g, V, cons, cparams, c, Ak, bk):  # type: ignore[no-untyped-def]
+    """Constraint ``c`` of the table ``cons`` by its compiled kernel: its rows on its first
+    body (columns 0–5 of Ak (nrow, 12)) and its second (6–11), b into bk. Returns the
+    kernel's status (0: written)."""
+    i, j, p0 = cons[c, 1], cons[c, 2], cons[c, 5]
+    second = j if j >= 0 else i
+    return _call_rows(cons[c, 0], (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
+
+
+@njit(cache=True)
+def constraint_block(t, g, V, cons, cparams, c, A, b):  # type: ignore[no-untyped-def]
+    """Constraint ``c``'s rows by :func:`kernel_rows` into its block of the tree's A (s, 12)
+    and b (s,), from row ``cons[c, 3]`` (columns 6–11 only for a constraint on two bodies).
+    Returns the kernel's status."""
+    r0, nrow = cons[c, 3], cons[c, 4]
+    Ak = np.empty((nrow, 12))
+    bk = np.empty(nrow)
+    status = kernel_rows(t, g, V, cons, cparams, c, Ak, bk)
+    if status != 0:
+        return status
+    width = 12 if cons[c, 2] >= 0 else 6
+    for a in range(nrow):
+        b[r0 + a] = bk[a]
+        for e in range(width):
+            A[r0 + a, e] = Ak[a, e]
+    return 0
+
+
+@njit(cache=True)
 def tree_rows_rigid(
     t: float,
     g: np.ndarray,
@@ -499,27 +528,9 @@ def tree_rows_rigid(
     A (s, 12) and b (s,), the results into ``out`` as :func:`tree_rigid` writes them. Returns
     0, or the status of a constraint kernel that failed (then ``out`` is not written)."""
     for c in range(cons.shape[0]):
-        kind, i, j, r0, nrow, p0 = (
-            cons[c, 0],
-            cons[c, 1],
-            cons[c, 2],
-            cons[c, 3],
-            cons[c, 4],
-            cons[c, 5],
-        )
-        Ak = np.empty((nrow, 12))
-        bk = np.empty(nrow)
-        second = j if j >= 0 else i
-        status = _call_rows(kind, (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
+        status = constraint_block(t, g, V, cons, cparams, c, A, b)
         if status != 0:
             return status
-        for a in range(nrow):
-            b[r0 + a] = bk[a]
-            for e in range(6):
-                A[r0 + a, e] = Ak[a, e]
-            if j >= 0:
-                for e in range(6):
-                    A[r0 + a, 6 + e] = Ak[a, 6 + e]
     tree_rigid(V, Q, A, b, P, out)
     return 0
 

@@ -53,7 +53,6 @@ from numba import types
 from numba.extending import intrinsic
 
 from gmuk._numba import kernel_address, kernel_caller, njit
-from gmuk.constraints.base import ROWS_KERNEL
 from gmuk.control.base import CONTROL_KERNEL
 from gmuk.dynamics import rigid_free_accel
 from gmuk.engine._uk_kernels import _qr_solve, uk_rigid
@@ -68,7 +67,7 @@ from gmuk.engine.integrators._program import (
     Program,
     reference_records,
 )
-from gmuk.engine.tree import TREE, tree_pair, tree_solve
+from gmuk.engine.tree import TREE, constraint_block, kernel_rows, tree_pair, tree_solve
 from gmuk.forces.base import FORCE_KERNEL
 from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
 
@@ -121,7 +120,6 @@ N_FLOATS = 8
 # ------------------------------------------------------------------------ right-hand side
 # The parts' kernels, called through the addresses in the program's tables (gmuk._numba).
 _call_force = kernel_caller(FORCE_KERNEL, "force model")
-_call_rows = kernel_caller(ROWS_KERNEL, "constraint")
 _call_control = kernel_caller(CONTROL_KERNEL, "controller")
 
 
@@ -453,8 +451,7 @@ def _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b):  # type: ignore[n
             continue
         Ak = np.empty((nrow, 12))
         bk = np.empty(nrow)
-        second = j if j >= 0 else i
-        status = _call_rows(kind, (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
+        status = kernel_rows(t, g, V, cons, cparams, c, Ak, bk)
         if status != 0:
             return status
         for a in range(nrow):
@@ -475,14 +472,7 @@ def _constraint_blocks(t, g, V, cons, cparams, io, r_off, P, A, b):  # type: ign
     packed tree ``P``). Returns 0 or the status of a failed kernel."""
     ndof = 6 * r_off.shape[0]  # rigid bodies only
     for c in range(cons.shape[0]):
-        kind, i, j, r0, nrow, p0 = (
-            cons[c, 0],
-            cons[c, 1],
-            cons[c, 2],
-            cons[c, 3],
-            cons[c, 4],
-            cons[c, 5],
-        )
+        kind, r0, nrow, p0 = cons[c, 0], cons[c, 3], cons[c, 4], cons[c, 5]
         if kind == PYTHON:  # A (nrow, n_dof) then b (nrow) at io[p0:]
             ia, ib = tree_pair(P, c)
             for a in range(nrow):
@@ -492,19 +482,9 @@ def _constraint_blocks(t, g, V, cons, cparams, io, r_off, P, A, b):  # type: ign
                         A[r0 + a, 6 + e] = io[p0 + a * ndof + r_off[ib] + e]
                 b[r0 + a] = io[p0 + nrow * ndof + a]
             continue
-        Ak = np.empty((nrow, 12))
-        bk = np.empty(nrow)
-        second = j if j >= 0 else i
-        status = _call_rows(kind, (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
+        status = constraint_block(t, g, V, cons, cparams, c, A, b)
         if status != 0:
             return status
-        for a in range(nrow):
-            b[r0 + a] = bk[a]
-            for e in range(6):
-                A[r0 + a, e] = Ak[a, e]
-            if j >= 0:
-                for e in range(6):
-                    A[r0 + a, 6 + e] = Ak[a, 6 + e]
     return 0
 
 
