@@ -17,8 +17,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from gmuk._validation import FloatArray
-from gmuk.dynamics import check_inertia, check_mass
-from gmuk.errors import DefinitionError
+from gmuk.dynamics import check_inertia, check_mass, singular_mass
+from gmuk.errors import DefinitionError, GmukError, InertiaError
 
 __all__ = ["Body", "BodyKind", "PointMass", "RigidBody", "SlackCoordinate"]
 
@@ -32,6 +32,15 @@ def _check_name(name: Any) -> str:
 def _check_mass(mass: Any, name: str) -> float:
     """The mass (kg) as :func:`gmuk.dynamics.check_mass` accepts it (1/m finite too)."""
     return check_mass(mass, name)
+
+
+def _physical_singular(mass: Any, inertia: Any, label: str) -> bool:
+    """Whether ``allow_singular=True`` would accept this mass and inertia."""
+    try:
+        check_inertia(mass, inertia, name=label, allow_singular=True)
+    except GmukError:
+        return False
+    return True
 
 
 class BodyKind(str, enum.Enum):
@@ -92,6 +101,11 @@ class Body(abc.ABC):
         object.__setattr__(self, "_name", name)
         object.__setattr__(self, "_mass", _check_mass(mass, f"{type(self).__name__} {name!r}"))
 
+    def _set_checked(self, name: str, mass: float) -> None:
+        """Name and a mass its subclass has validated already."""
+        object.__setattr__(self, "_name", name)
+        object.__setattr__(self, "_mass", mass)
+
     @property
     def name(self) -> str:
         """Unique name of the body within a System."""
@@ -127,6 +141,12 @@ class RigidBody(Body):
         definite, principal moments satisfying the triangle inequality, each between
         2.2e-308 and 4.5e307 kg·m² (J⁻¹ finite), and J₃/J₁ ≤ 1e12 (J⁻¹ usable). See
         :func:`gmuk.dynamics.check_inertia`.
+    allow_singular : bool, optional
+        Accept a singular mass block (default False): a link without mass (m = 0, J = 0), a
+        point mass (J = 0) or a rod (one zero moment), as robot descriptions have them. Such
+        a body has no acceleration of its own; a System takes it only under the tree solve
+        of joints that determine its motion (:class:`gmuk.engine.tree.TreeSolver`), and only
+        loads that go through that solve act on it (no unmodeled force, no controller).
 
     Raises
     ------
@@ -141,15 +161,35 @@ class RigidBody(Body):
 
     dof = 6
     kind = BodyKind.RIGID
-    __slots__ = ("_J",)
+    __slots__ = ("_J", "_singular")
     _J: FloatArray
+    _singular: bool
 
-    def __init__(self, name: str, mass: float, inertia: Any) -> None:
-        m, J = check_inertia(mass, inertia, name=f"RigidBody {_check_name(name)!r}")
-        super().__init__(name, m)
+    def __init__(
+        self, name: str, mass: float, inertia: Any, *, allow_singular: bool = False
+    ) -> None:
+        name = _check_name(name)
+        label = f"RigidBody {name!r}"
+        try:
+            m, J = check_inertia(mass, inertia, name=label, allow_singular=bool(allow_singular))
+        except InertiaError as exc:
+            if allow_singular or not _physical_singular(mass, inertia, label):
+                raise
+            raise InertiaError(
+                f"{exc} (a link without mass or rotational inertia is accepted with "
+                "allow_singular=True, under the tree solve of robot joints)"
+            ) from None
+        self._set_checked(name, m)
         J = J.copy()
         J.setflags(write=False)
         object.__setattr__(self, "_J", J)
+        object.__setattr__(self, "_singular", bool(allow_singular) and singular_mass(m, J))
+
+    @property
+    def singular(self) -> bool:
+        """Whether the mass block ``blkdiag(J, m I₃)`` is singular (only with
+        ``allow_singular``: m = 0, or a principal moment that is zero)."""
+        return self._singular
 
     @property
     def inertia(self) -> FloatArray:

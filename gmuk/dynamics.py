@@ -22,9 +22,12 @@ __all__ = [
     "check_spatial_inertia",
     "free_acceleration",
     "g_ddot",
+    "inertia_pinv",
     "kinetic_energy",
+    "singular_mass",
     "spatial_inertia",
     "spatial_momentum",
+    "zero_moments",
 ]
 
 #: Relative tolerance for symmetry of J and for the triangle inequalities of its moments.
@@ -97,35 +100,47 @@ def _reciprocal(x: float) -> float:
         return float(np.float64(1.0) / np.float64(x))
 
 
+@njit(cache=True, inline="always")
+def body_moment(
+    V: np.ndarray, J: np.ndarray, k: int, q0: float, q1: float, q2: float
+) -> tuple[float, float, float]:
+    """Jω × ω + τ of body k (N·m): the rotational part of ad*_V 𝕀V + Q (McCann 2020,
+    Eq. 10b), for twists V (n, 6), inertias J (n, 3, 3) and the applied moment τ = (q0, q1,
+    q2)."""
+    w0, w1, w2 = V[k, 0], V[k, 1], V[k, 2]
+    h0 = J[k, 0, 0] * w0 + J[k, 0, 1] * w1 + J[k, 0, 2] * w2
+    h1 = J[k, 1, 0] * w0 + J[k, 1, 1] * w1 + J[k, 1, 2] * w2
+    h2 = J[k, 2, 0] * w0 + J[k, 2, 1] * w1 + J[k, 2, 2] * w2
+    return h1 * w2 - h2 * w1 + q0, h2 * w0 - h0 * w2 + q1, h0 * w1 - h1 * w0 + q2
+
+
 @njit(cache=True)
 def rigid_free_accel(
     V: np.ndarray, J: np.ndarray, Jinv: np.ndarray, m: np.ndarray, Q: np.ndarray
 ) -> np.ndarray:
     """V̇ = 𝕀⁻¹(ad*_V 𝕀 V + Q) for n rigid bodies: (n, 6) twists and wrenches → (n, 6).
 
-    ad*_V 𝕀V = [Jω × ω; m v × ω] (McCann 2020, Eq. 10b, written out).
+    ad*_V 𝕀V = [Jω × ω; m v × ω] (McCann 2020, Eq. 10b, written out); 𝕀⁻¹ takes J⁺ and
+    1/m = 0 for a body with a singular mass block (its solve supplies the rest).
     """
     n = V.shape[0]
     out = np.empty((n, 6))
     for k in range(n):
         w0, w1, w2 = V[k, 0], V[k, 1], V[k, 2]
         v0, v1, v2 = V[k, 3], V[k, 4], V[k, 5]
-        h0 = J[k, 0, 0] * w0 + J[k, 0, 1] * w1 + J[k, 0, 2] * w2
-        h1 = J[k, 1, 0] * w0 + J[k, 1, 1] * w1 + J[k, 1, 2] * w2
-        h2 = J[k, 2, 0] * w0 + J[k, 2, 1] * w1 + J[k, 2, 2] * w2
-        L0 = h1 * w2 - h2 * w1 + Q[k, 0]
-        L1 = h2 * w0 - h0 * w2 + Q[k, 1]
-        L2 = h0 * w1 - h1 * w0 + Q[k, 2]
+        L0, L1, L2 = body_moment(V, J, k, Q[k, 0], Q[k, 1], Q[k, 2])
         for i in range(3):
             out[k, i] = Jinv[k, i, 0] * L0 + Jinv[k, i, 1] * L1 + Jinv[k, i, 2] * L2
-        im = 1.0 / m[k]
+        im = 1.0 / m[k] if m[k] > 0.0 else 0.0  # a body without mass: M⁺ (its solve decides)
         out[k, 3] = v1 * w2 - v2 * w1 + Q[k, 3] * im
         out[k, 4] = v2 * w0 - v0 * w2 + Q[k, 4] * im
         out[k, 5] = v0 * w1 - v1 * w0 + Q[k, 5] * im
     return out
 
 
-def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatArray]:
+def check_inertia(
+    mass: Any, J: Any, name: str = "body", *, allow_singular: bool = False
+) -> tuple[float, FloatArray]:
     """Validate a mass and a central inertia tensor.
 
     Parameters
@@ -141,6 +156,14 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
         (:data:`MAX_CONDITION`: J⁻¹ then keeps about 4 significant digits).
     name : str
         Used in error messages.
+    allow_singular : bool, optional
+        Accept a singular mass block ``blkdiag(J, m I)`` (default False): m = 0 (then J must
+        be exactly zero: a body without mass has no rotational inertia), and J positive
+        semidefinite, a principal moment at or below ``J₃ / MAX_CONDITION`` counting as zero
+        (:func:`zero_moments`); the other conditions hold for the moments that are not zero.
+        Such a body has no acceleration of its own: only a solve in which its constraints
+        determine it (the tree solve) takes it (McCann 2020's UK equation needs M⁻¹;
+        Udwadia & Phohomsiri 2006 give the singular-M form).
 
     Returns
     -------
@@ -163,12 +186,15 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
     problems: list[str] = []
     m = _real_mass(mass, name)
     if problem := _mass_problem(m):
-        problems.append(problem)
+        if not (allow_singular and m == 0.0):
+            problems.append(problem)
     Jm = as_array(J, (3, 3), f"{name}: inertia", batch=False)
     scale = max(float(np.abs(Jm).max()), np.finfo(float).tiny)
     asym = float(np.abs(Jm / scale - Jm.T / scale).max()) * scale  # no overflow near 1e308
     if asym > INERTIA_TOL * scale:
         problems.append(f"inertia must be symmetric; got max|J − Jᵀ| = {asym:.3g} kg·m²")
+    elif allow_singular:
+        problems += _singular_inertia_problems(m, Jm, scale)
     else:
         # eigenvalues of J / scale, then scaled back: no overflow for entries near 1e308
         scaled = np.linalg.eigvalsh(0.5 * (Jm / scale + Jm.T / scale))
@@ -198,6 +224,93 @@ def check_inertia(mass: Any, J: Any, name: str = "body") -> tuple[float, FloatAr
     if problems:
         raise InertiaError(f"{name}: " + "; ".join(problems))
     return m, Jm
+
+
+def zero_moments(J: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """J's principal moments and axes, a moment at or below ``J₃ / MAX_CONDITION`` in
+    magnitude set to zero: the moments J⁻¹ could not resolve (:data:`MAX_CONDITION`), and
+    round-off such as the 5e-20 kg·m² a URDF's zero inertia picks up when it is moved to the
+    centre of mass.
+
+    Parameters
+    ----------
+    J : ndarray (3, 3)
+        A symmetric central inertia (kg·m², body frame).
+
+    Returns
+    -------
+    (ndarray (3,), ndarray (3, 3))
+        The moments, ascending (kg·m²), and the principal axes as columns (body frame).
+    """
+    scale = max(float(np.abs(J).max()), np.finfo(float).tiny)
+    scaled, axes = np.linalg.eigh(0.5 * (J / scale + J.T / scale))
+    scaled[np.abs(scaled) <= max(scaled[2], 0.0) / MAX_CONDITION] = 0.0
+    with np.errstate(over="ignore"):
+        return scaled * scale, axes
+
+
+def inertia_pinv(J: FloatArray) -> FloatArray:
+    """J⁺, the Moore–Penrose pseudo-inverse of a central inertia, leaving out the moments
+    :func:`zero_moments` sets to zero (J⁻¹ when it sets none).
+
+    Parameters
+    ----------
+    J : ndarray (3, 3)
+        A symmetric positive-semidefinite central inertia (kg·m², body frame).
+
+    Returns
+    -------
+    ndarray (3, 3)
+        J⁺ (kg⁻¹·m⁻², body frame).
+    """
+    moments, axes = zero_moments(J)
+    inv = np.zeros(3)
+    nz = moments != 0.0
+    inv[nz] = 1.0 / moments[nz]
+    return np.asarray((axes * inv) @ axes.T)
+
+
+def _singular_inertia_problems(m: float, J: FloatArray, scale: float) -> list[str]:
+    """What :func:`check_inertia` with ``allow_singular`` refuses in a symmetric J."""
+    moments, _ = zero_moments(J)
+    shown = np.array2string(moments, precision=6)
+    if m == 0.0 and np.any(J != 0.0):
+        return [
+            "a body without mass has no rotational inertia: J must be zero when m = 0; got "
+            f"principal moments {shown} kg·m²"
+        ]
+    if moments[0] < 0.0:
+        return [f"inertia must be positive semidefinite; got principal moments {shown} kg·m²"]
+    nonzero = moments[moments != 0.0]
+    if nonzero.size and not (USABLE_MIN <= nonzero[0] and nonzero[-1] <= USABLE_MAX):
+        return [
+            f"principal moments must be zero or between {USABLE_MIN:.3g} and "
+            f"{USABLE_MAX:.3g} kg·m²; got {shown} kg·m²"
+        ]
+    if moments[0] + moments[1] < moments[2] * (1.0 - INERTIA_TOL):  # finite: ≤ 4.5e307 each
+        return [
+            f"principal moments must satisfy the triangle inequality J₁ + J₂ ≥ J₃; got "
+            f"{shown} kg·m² ({moments[0] + moments[1]:.6g} < {moments[2]:.6g})"
+        ]
+    return []
+
+
+def singular_mass(m: float, J: FloatArray) -> bool:
+    """Whether the mass block ``blkdiag(J, m I)`` is singular.
+
+    Parameters
+    ----------
+    m : float
+        Mass (kg).
+    J : ndarray (3, 3)
+        Central inertia (kg·m², body frame).
+
+    Returns
+    -------
+    bool
+        m = 0, or a moment of :func:`zero_moments` is zero.
+    """
+    return m == 0.0 or bool(zero_moments(J)[0][0] == 0.0)
 
 
 def check_spatial_inertia(inertia: Any, name: str = "inertia") -> FloatArray:

@@ -268,7 +268,7 @@ class UKSolver(abc.ABC):
             ac,
             extra,
             total,
-            system._apply_M(ac),
+            self._constraint_wrench(ac),
             control,
             unmodeled,
             lam,
@@ -277,6 +277,10 @@ class UKSolver(abc.ABC):
             unreachable,
             z_dot,
         )
+
+    def _constraint_wrench(self, ac: FloatArray) -> FloatArray:
+        """The constraint wrenches Aᵀλ = M ν̇_c of the solve just made."""
+        return self.system._apply_M(ac)
 
     @abc.abstractmethod
     def solve(self, state: State, a: FloatArray, rows: Any = None) -> Solution:

@@ -37,6 +37,7 @@ from gmuk._validation import (
 from gmuk.bodies import Body, BodyKind, RigidBody
 from gmuk.constraints.base import Constraint, as_rows
 from gmuk.control.base import Controller
+from gmuk.dynamics import inertia_pinv
 from gmuk.engine import _uk_kernels, solvers, uk
 from gmuk.engine.events import Event
 from gmuk.engine.integrate import simulate as _simulate
@@ -85,6 +86,20 @@ def _names_its_options(func: Callable[_P, _R]) -> Callable[_P, _R]:
 
 #: Above this many degrees of freedom, ``sparse="auto"`` selects the sparse solve.
 SPARSE_THRESHOLD = 300
+
+
+def _pinv_block(body: Any) -> FloatArray:
+    """M⁺ = blkdiag(J⁺, m⁺ I₃) of a rigid body with a singular mass block."""
+    out = np.zeros((6, 6))
+    out[:3, :3] = inertia_pinv(body.inertia)
+    out[3:, 3:] = (1.0 / body.mass if body.mass > 0.0 else 0.0) * np.eye(3)
+    return out
+
+
+def _sqrt_psd(B: FloatArray) -> FloatArray:
+    """B^½ of a symmetric positive-semidefinite B (for M⁺^½ from M⁺)."""
+    w, U = np.linalg.eigh(B)
+    return np.asarray((U * np.sqrt(np.clip(w, 0.0, None))) @ U.T)
 
 
 class System:
@@ -219,6 +234,8 @@ class System:
         self._zero_loads.setflags(write=False)
         self._zero_z = self._zero_loads[:0]
         solver_cls = self._choose_solver(solver, sparse)
+        if problems := self._singular_problems(solver_cls):
+            raise DefinitionError(problems)
         self.sparse = solver_cls.wants_sparse(self)
         self._build_mass()
         self._build_index()
@@ -253,6 +270,44 @@ class System:
         if problems:
             raise DefinitionError(problems)
         return cls
+
+    def _singular_problems(self, solver_cls: type[UKSolver]) -> list[str]:
+        """Why the bodies with a singular mass block (``RigidBody(allow_singular=True)``)
+        cannot be solved here: they have no M⁻¹, so only the tree solve, which determines
+        their motion through their joints, takes them, and only with every load on them
+        going through that solve."""
+        singular = [b.name for b in self.bodies if getattr(b, "singular", False)]
+        if not singular:
+            return []
+        shown = ", ".join(repr(n) for n in singular[:5]) + (" …" if len(singular) > 5 else "")
+        out = []
+        if not issubclass(solver_cls, TreeSolver):
+            out.append(
+                f"bodies {shown} have a singular mass block (allow_singular): only the tree "
+                "solve takes them (every constraint an equality on one or two rigid bodies, "
+                f"forming a tree or forest with the ground); this System's solver is "
+                f"{solver_cls.name!r}"
+            )
+        names = set(singular)
+
+        def acts_on_singular(bodies: Any) -> bool:
+            if bodies is None:
+                return True
+            return any((b if isinstance(b, str) else b.name) in names for b in bodies)
+
+        for f in self.forces:
+            if not f.modeled and acts_on_singular(f.bodies):
+                out.append(
+                    f"force {f.name!r} is unmodeled and acts on bodies with a singular mass "
+                    f"block ({shown}): a load the solve does not see needs M⁻¹"
+                )
+        for ctl in self.controllers:
+            if acts_on_singular(ctl.bodies):
+                out.append(
+                    f"controller {ctl.name!r} acts on bodies with a singular mass block "
+                    f"({shown}): a controller's load is applied after the solve, through M⁻¹"
+                )
+        return out
 
     def _joint_tree(self) -> bool:
         """Whether every constraint is a joint of :mod:`gmuk.robots` and they form a tree or
@@ -331,19 +386,35 @@ class System:
         self._M_blocks = blocks
         rigid = [b for b in self.bodies if isinstance(b, RigidBody)]
         self._J = np.array([b.inertia for b in rigid]).reshape(-1, 3, 3)
-        self._Jinv = np.linalg.inv(self._J) if rigid else self._J.copy()
+        #: each rigid body's singular mass block (allow_singular): J⁺ and 1/m → 0 for it
+        self._singular = np.array([getattr(b, "singular", False) for b in rigid], dtype=bool)
+        if self._singular.any():
+            self._Jinv = np.array(
+                [inertia_pinv(J) if sing else np.linalg.inv(J)
+                 for J, sing in zip(self._J, self._singular, strict=True)]
+            ).reshape(-1, 3, 3)  # fmt: skip
+        else:
+            self._Jinv = np.linalg.inv(self._J) if rigid else self._J.copy()
         self._m_rigid = np.array([b.mass for b in rigid])
         euclid = [b for b in self.bodies if b.kind is not BodyKind.RIGID]
         self._m_euclid = (
             np.concatenate([np.full(b.dof, b.mass) for b in euclid]) if euclid else np.zeros(0)
         )
-        inv = [np.linalg.inv(B) for B in blocks]
-        inv_sqrt = [uk.matrix_power_spd(B, -0.5) for B in blocks]
+        singular = [getattr(b, "singular", False) for b in self.bodies]
+        # M⁺ = blkdiag(J⁺, m⁺ I) for a singular block: no strategy that reads it takes one
+        inv = [
+            _pinv_block(body) if sing else np.linalg.inv(B)
+            for body, B, sing in zip(self.bodies, blocks, singular, strict=True)
+        ]
+        inv_sqrt = [
+            _sqrt_psd(Bi) if sing else uk.matrix_power_spd(B, -0.5)
+            for B, Bi, sing in zip(blocks, inv, singular, strict=True)
+        ]
         if self.sparse:  # never form n_dof × n_dof dense matrices on the sparse path
             self._Minv_sp = sp.block_diag(inv, format="csr")
             self._Minv_sqrt_sp = sp.block_diag(inv_sqrt, format="csr")
         else:
-            self._M_dense = scipy.linalg.block_diag(*blocks)
+            self._M_dense = scipy.linalg.block_diag(*self._M_blocks)
             self._Minv_dense = scipy.linalg.block_diag(*inv)
             self._Minv_sqrt = scipy.linalg.block_diag(*inv_sqrt)
 

@@ -50,7 +50,7 @@ from gmuk._numba import kernel_address, kernel_caller, njit
 from gmuk._validation import FloatArray, all_finite
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import ROWS_KERNEL, as_rows
-from gmuk.dynamics import rigid_free_accel
+from gmuk.dynamics import body_moment, rigid_free_accel
 from gmuk.engine import _uk_kernels, uk
 from gmuk.engine._uk_kernels import consistency_scale
 from gmuk.engine.solvers import (
@@ -76,6 +76,7 @@ __all__ = [
     "TREE",
     "TREE_SIGNATURE",
     "TreeSolver",
+    "body_rhs",
     "tree_pair",
     "tree_params",
     "tree_rigid",
@@ -111,7 +112,8 @@ TREE = 4
 
 # Layout of the packed parameters P (float64): [unused, consistency_tol, n_b, n_c,
 # J (9 n_b), J⁻¹ (9 n_b), m (n_b), order (n_b + n_c), parent (n_b + n_c), body_a (n_c),
-# body_b (n_c), rows (n_c)]. Nodes 0 … n_b − 1 are the bodies, n_b + k constraint k.
+# body_b (n_c), rows (n_c), n_singular, singular (n_b)]. Nodes 0 … n_b − 1 are the bodies,
+# n_b + k constraint k; J⁻¹ is J⁺ for a body with a singular mass block (``singular`` 1).
 _HEAD = 4
 
 
@@ -186,12 +188,15 @@ def tree_params(
     pairs: list[tuple[int, int]],
     rows: list[int],
     consistency_tol: float,
+    singular: np.ndarray | None = None,
 ) -> np.ndarray:
     """The constant arguments of :func:`tree_solve` and :func:`tree_rigid` in one writable
     float64 vector (see ``_HEAD``): the bodies' central inertias J (n_b, 3, 3) (kg·m²),
-    their inverses, masses m (n_b,) (kg), the tree (:func:`tree_structure`), each
-    constraint's bodies and row count."""
+    their inverses (J⁺ where the mass block is singular), masses m (n_b,) (kg), the tree
+    (:func:`tree_structure`), each constraint's bodies and row count, and which bodies have
+    a singular mass block (``singular``, bool (n_b,); none by default)."""
     nb, nc = m.shape[0], len(pairs)
+    flags = np.zeros(nb) if singular is None else np.asarray(singular, dtype=float)
     return np.concatenate(
         [
             [0.0, float(consistency_tol), float(nb), float(nc)],
@@ -203,8 +208,47 @@ def tree_params(
             [float(a) for a, _ in pairs],
             [float(b) for _, b in pairs],
             np.asarray(rows, dtype=float),
+            [float(np.count_nonzero(flags))],
+            flags,
         ]
     ).astype(np.float64)
+
+
+@njit(cache=True, inline="always")
+def _singular_at(P: np.ndarray) -> int:
+    """Offset in P of the count of bodies with a singular mass block (their flags follow)."""
+    nb = int(P[2])
+    nc = int(P[3])
+    return _HEAD + 19 * nb + 2 * (nb + nc) + 3 * nc
+
+
+@njit(cache=True)
+def body_rhs(V: np.ndarray, Q: np.ndarray, a: np.ndarray, P: np.ndarray, r: np.ndarray) -> None:
+    """r_i = Q_i + ad*_V 𝕀V − M_i a_i (6 n_b,) for each body with a singular mass block, 0
+    for the others: what of the loads the free acceleration ``a`` (from J⁺, and 1/m → 0)
+    leaves to the solve, whose body equations are ``M_i ν̇_c,i + (Aᵀμ)_i = r_i``
+    (Udwadia & Phohomsiri 2006: a singular M with the constraints determining ν̇).
+    V (n_b, 6) twists, Q (6 n_b,) modeled wrenches (N·m, N), a (6 n_b,)."""
+    nb = V.shape[0]
+    o = _HEAD
+    J = P[o : o + 9 * nb].reshape((nb, 3, 3))
+    m = P[o + 18 * nb : o + 19 * nb]
+    f = _singular_at(P) + 1
+    for k in range(nb):
+        o6 = 6 * k
+        for e in range(6):
+            r[o6 + e] = 0.0
+        if P[f + k] == 0.0:
+            continue
+        w0, w1, w2 = V[k, 0], V[k, 1], V[k, 2]
+        v0, v1, v2 = V[k, 3], V[k, 4], V[k, 5]
+        L = body_moment(V, J, k, Q[o6], Q[o6 + 1], Q[o6 + 2])
+        F = (v1 * w2 - v2 * w1, v2 * w0 - v0 * w2, v0 * w1 - v1 * w0)
+        for i in range(3):
+            r[o6 + i] = L[i] - (
+                J[k, i, 0] * a[o6] + J[k, i, 1] * a[o6 + 1] + J[k, i, 2] * a[o6 + 2]
+            )
+            r[o6 + 3 + i] = Q[o6 + 3 + i] + m[k] * (F[i] - a[o6 + 3 + i])
 
 
 # ----------------------------------------------------------------------------- kernels
@@ -262,8 +306,194 @@ def _chol_solve(C: np.ndarray, d: int, sign: float, y: np.ndarray) -> None:
 
 
 @njit(cache=True)
+def _householder(H: np.ndarray, dk: int, Q: np.ndarray, R: np.ndarray) -> bool:
+    """H (6 × dk) = Q [R; 0]: Q (6 × 6) orthogonal, R (dk × dk) upper triangular, by
+    Householder reflections; False when a diagonal entry of R is not above PIVOT_TOL times
+    the largest column norm of H (H not certified to have full column rank)."""
+    Wk = np.zeros((6, 6))
+    big = 0.0
+    for v in range(dk):
+        acc = 0.0
+        for u in range(6):
+            Wk[u, v] = H[u, v]
+            acc += H[u, v] * H[u, v]
+        big = max(big, np.sqrt(acc))
+    for u in range(6):
+        for v in range(6):
+            Q[u, v] = 1.0 if u == v else 0.0
+    if not big > 0.0:
+        return dk == 0
+    vec = np.empty(6)
+    for j in range(dk):
+        norm = 0.0
+        for u in range(j, 6):
+            norm += Wk[u, j] * Wk[u, j]
+        norm = np.sqrt(norm)
+        if not norm > PIVOT_TOL * big:
+            return False
+        alpha = -norm if Wk[j, j] >= 0.0 else norm
+        vv = 0.0
+        for u in range(6):
+            vec[u] = Wk[u, j] if u >= j else 0.0
+        vec[j] -= alpha
+        for u in range(j, 6):
+            vv += vec[u] * vec[u]
+        for c in range(j, dk):  # Wk ← (I − 2 v vᵀ / vᵀv) Wk
+            acc = 0.0
+            for u in range(j, 6):
+                acc += vec[u] * Wk[u, c]
+            acc *= 2.0 / vv
+            for u in range(j, 6):
+                Wk[u, c] -= acc * vec[u]
+        for r in range(6):  # Q ← Q (I − 2 v vᵀ / vᵀv)
+            acc = 0.0
+            for u in range(j, 6):
+                acc += Q[r, u] * vec[u]
+            acc *= 2.0 / vv
+            for u in range(j, 6):
+                Q[r, u] -= acc * vec[u]
+    for u in range(dk):
+        for v in range(dk):
+            R[u, v] = Wk[u, v] if v >= u else 0.0
+    return True
+
+
+@njit(cache=True)
+def _pair_solve(
+    D: np.ndarray,
+    Q: np.ndarray,
+    R: np.ndarray,
+    L: np.ndarray,
+    dk: int,
+    f: np.ndarray,
+    g: np.ndarray,
+) -> None:
+    """[x; μ] = K⁻¹ [f; g] in place of (f, g) for K = [[D, H], [Hᵀ, 0]] (D 6 × 6, H 6 × dk)
+    by the null-space method: with H = Q [R; 0] = Q₁R, x = Q₁R⁻ᵀg + Q₂y where
+    N y = Q₂ᵀ(f − D Q₁R⁻ᵀg), N = Q₂ᵀ D Q₂ = L Lᵀ (the inertia along the motions joint k
+    allows, as in the articulated-body algorithm), and μ = R⁻¹ Q₁ᵀ (f − D x)."""
+    w = np.empty(6)
+    for u in range(dk):  # w = R⁻ᵀ g
+        acc = g[u]
+        for q in range(u):
+            acc -= R[q, u] * w[q]
+        w[u] = acc / R[u, u]
+    x = np.zeros(6)
+    for e in range(6):
+        acc = 0.0
+        for u in range(dk):
+            acc += Q[e, u] * w[u]
+        x[e] = acc
+    t = np.empty(6)
+    for e in range(6):  # t = f − D x₀
+        acc = f[e]
+        for q in range(6):
+            acc -= D[e, q] * x[q]
+        t[e] = acc
+    nf = 6 - dk
+    yv = np.empty(6)
+    for u in range(nf):
+        acc = 0.0
+        for e in range(6):
+            acc += Q[e, dk + u] * t[e]
+        yv[u] = acc
+    _chol_solve(L, nf, 1.0, yv)
+    for e in range(6):
+        acc = 0.0
+        for u in range(nf):
+            acc += Q[e, dk + u] * yv[u]
+        x[e] += acc
+    for e in range(6):  # t = f − D x
+        acc = f[e]
+        for q in range(6):
+            acc -= D[e, q] * x[q]
+        t[e] = acc
+    for u in range(dk - 1, -1, -1):  # μ = R⁻¹ Q₁ᵀ t
+        acc = 0.0
+        for e in range(6):
+            acc += Q[e, u] * t[e]
+        for q in range(u + 1, dk):
+            acc -= R[u, q] * g[q]
+        g[u] = acc / R[u, u]
+    for e in range(6):
+        f[e] = x[e]
+
+
+@njit(cache=True)
+def _eliminate_pair(i, k, p, nb, A, row0, body_a, dim, D, C, X, y):  # type: ignore[no-untyped-def]
+    """Eliminate body i, whose D_i is singular, together with its parent constraint node k
+    as one node K = [[D_i, H], [Hᵀ, 0]] (H: constraint k's rows on body i, transposed),
+    coupled to k's parent body p (−1: none) by [0; G] (G: k's rows on p).
+
+    K is invertible exactly when H has full column rank and D_i is positive definite on the
+    motions of body i that joint k allows with p held (a massless link between two joints:
+    its own D_i lacks the freedom of its child's joint, its parent joint supplies it). K is
+    solved by the null-space method (:func:`_pair_solve`): a Householder QR of H and the
+    Cholesky factor of N = Q₂ᵀ D_i Q₂, each with the pivot test (False: not certified).
+    Writes z_K into y[i], y[k]; X_K = K⁻¹ [0; G] into X[i], X[k]; and updates p:
+    D_p −= Gᵀ X_k, y_p −= Gᵀ z_k (the block LDLᵀ step of tree_solve for the node K)."""
+    dk = dim[k]
+    c = k - nb
+    half = 0 if int(body_a[c]) == i else 6
+    H = np.zeros((6, 6))
+    for u in range(6):
+        for v in range(dk):
+            H[u, v] = A[row0[c] + v, half + u]
+    Q = np.empty((6, 6))
+    R = np.zeros((6, 6))
+    if not _householder(H, dk, Q, R):
+        return False
+    nf = 6 - dk
+    N = np.empty((6, 6))
+    for u in range(nf):
+        for v in range(nf):
+            acc = 0.0
+            for e in range(6):
+                for q in range(6):
+                    acc += Q[e, dk + u] * D[i, e, q] * Q[q, dk + v]
+            N[u, v] = acc
+    L = C[i]
+    if not _cholesky(N, nf, 1.0, L):
+        return False
+    Di = D[i]
+    _pair_solve(Di, Q, R, L, dk, y[i], y[k])  # z_K
+    if p < 0:
+        return True
+    hp = 0 if int(body_a[c]) == p else 6
+    f = np.empty(6)
+    g = np.empty(6)
+    for v in range(6):  # X_K = K⁻¹ [0; G], column by column
+        for u in range(6):
+            f[u] = 0.0
+        for u in range(dk):
+            g[u] = A[row0[c] + u, hp + v]
+        _pair_solve(Di, Q, R, L, dk, f, g)
+        for u in range(6):
+            X[i, u, v] = f[u]
+        for u in range(dk):
+            X[k, u, v] = g[u]
+    for u in range(6):  # D_p −= Gᵀ X_k, y_p −= Gᵀ z_k
+        for v in range(6):
+            acc = 0.0
+            for q in range(dk):
+                acc += A[row0[c] + q, hp + u] * X[k, q, v]
+            D[p, u, v] -= acc
+        acc = 0.0
+        for q in range(dk):
+            acc += A[row0[c] + q, hp + u] * y[k, q]
+        y[p, u] -= acc
+    return True
+
+
+@njit(cache=True)
 def tree_solve(
-    a: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, ac: np.ndarray, lam: np.ndarray
+    a: np.ndarray,
+    rhs: np.ndarray,
+    A: np.ndarray,
+    b: np.ndarray,
+    P: np.ndarray,
+    ac: np.ndarray,
+    lam: np.ndarray,
 ) -> tuple[float, float, int]:
     """The UK solve of tree-structured rows by block LDLᵀ with no fill-in (module docstring).
 
@@ -271,6 +501,9 @@ def tree_solve(
     ----------
     a : ndarray (6 n_b,)
         ν̇_a, the free accelerations [ω̇; v̇] of the bodies (rad/s², m/s²).
+    rhs : ndarray (6 n_b,)
+        The bodies' right-hand side (:func:`body_rhs`; N·m, N), read only for bodies with a
+        singular mass block (zero for the others by definition).
     A : ndarray (s, 12)
         Each constraint's rows on its first body (columns 0–5) and its second (6–11, zero
         for a constraint to the ground), stacked in constraint order.
@@ -330,6 +563,14 @@ def tree_solve(
             for v in range(3):
                 D[i, u, v] = J[i, u, v]
             D[i, 3 + u, 3 + u] = m[i]
+    n_singular = int(P[_singular_at(P)])
+    if n_singular:  # the bodies' right-hand side r_i, zero where M_i is invertible
+        for e in range(6 * nb):
+            y[e // 6, e % 6] = rhs[e]
+    up = np.empty(nn, dtype=np.int64)  # the parent in the back-substitution
+    merged = np.zeros(nn, dtype=np.bool_)
+    for i in range(nn):
+        up[i] = int(parent[i])
     for k in range(nc):  # the joint nodes' right-hand side r_k = b_k − A_k a
         ia = int(body_a[k])
         ib = int(body_b[k])
@@ -346,10 +587,20 @@ def tree_solve(
     w = np.empty(6)
     for step in range(nn):
         i = int(order[step])
+        if merged[i]:
+            continue
         di = dim[i]
         sign = 1.0 if i < nb else -1.0
         if not _cholesky(D[i], di, sign, C[i]):
-            return np.nan, np.nan, 1
+            if not (n_singular and i < nb and parent[i] >= 0):
+                return np.nan, np.nan, 1
+            # a singular body's D_i: eliminate it with its joint to the parent, one node
+            k = int(parent[i])
+            if not _eliminate_pair(i, k, int(parent[k]), nb, A, row0, body_a, dim, D, C, X, y):
+                return np.nan, np.nan, 1
+            merged[int(parent[i])] = True
+            up[i] = int(parent[int(parent[i])])
+            continue
         p = int(parent[i])
         # z_i = D_i⁻¹ y_i (y_i is final: every child has been subtracted)
         for u in range(di):
@@ -393,7 +644,7 @@ def tree_solve(
     # x_i = z_i − X_i x_p, roots first (y holds z, then x)
     for step in range(nn - 1, -1, -1):
         i = int(order[step])
-        p = int(parent[i])
+        p = up[i]
         if p >= 0:
             di = dim[i]
             dp = dim[p]
@@ -441,7 +692,8 @@ def tree_rigid(
 ) -> None:
     """Free accelerations (Eq. 10b) of the twists V (n_b, 6) under the modeled wrenches Q
     (6 n_b,), :func:`tree_solve` of the rows A (s, 12), b (s,), the constraint wrenches
-    M ν̇_c and the total, into ``out`` (4n + s + 3, n = 6 n_b): ``[a, ν̇_c, total, M ν̇_c, λ,
+    Aᵀλ (M ν̇_c, less :func:`body_rhs` for a body with a singular mass block) and the
+    total, into ``out`` (4n + s + 3, n = 6 n_b): ``[a, ν̇_c, total, M ν̇_c, λ,
     residual, scale, status]``, status 3 when solved but ``residual > consistency_tol ·
     scale``; the other entries are meaningful only for status 0 and 3 (the layout of
     :func:`gmuk.engine._uk_kernels.uk_rigid`)."""
@@ -454,7 +706,9 @@ def tree_rigid(
     m = P[o + 18 * nb : o + 19 * nb]
     a = rigid_free_accel(V, J, Jinv, m, Q.reshape((nb, 6))).reshape(-1)
     ac = out[n : 2 * n]
-    residual, scale, status = tree_solve(a, A, b, P, ac, out[4 * n : 4 * n + s])
+    rhs = np.empty(n)
+    body_rhs(V, Q, a, P, rhs)
+    residual, scale, status = tree_solve(a, rhs, A, b, P, ac, out[4 * n : 4 * n + s])
     for k in range(nb):
         for i in range(6):
             r = 6 * k + i
@@ -464,8 +718,8 @@ def tree_rigid(
             o3 = 6 * k
             out[3 * n + o3 + i] = (
                 J[k, i, 0] * ac[o3] + J[k, i, 1] * ac[o3 + 1] + J[k, i, 2] * ac[o3 + 2]
-            )
-            out[3 * n + o3 + 3 + i] = m[k] * ac[o3 + 3 + i]
+            ) - rhs[o3 + i]
+            out[3 * n + o3 + 3 + i] = m[k] * ac[o3 + 3 + i] - rhs[o3 + 3 + i]
     out[4 * n + s] = residual
     out[4 * n + s + 1] = scale
     if status == 0 and residual > P[1] * scale:
@@ -637,6 +891,7 @@ class TreeSolver(UKSolver):
         self._constraints = system.constraints
         self._rows_n: list[int] | None = None
         self._P = np.zeros(1)
+        self._last_rhs = np.zeros(system.layout.n_dof)
         terms = [c._compiled_term() for c in system.constraints]
         # every constraint compiled: its rows in the same compiled call as the solve
         self._cons: np.ndarray | None = None
@@ -667,7 +922,7 @@ class TreeSolver(UKSolver):
         self._rows_n = rows
         self._P = tree_params(
             s._J, s._Jinv, s._m_rigid, self._order, self._parent, self._pairs, rows,
-            s.consistency_tol,
+            s.consistency_tol, s._singular,
         )  # fmt: skip
 
     def loop_constants(self, state: State) -> np.ndarray:
@@ -810,25 +1065,47 @@ class TreeSolver(UKSolver):
         """The tree solve of the rows at ``state``, with the dense or sparse solve where it
         cannot certify its answer (``rows``: the blocks a call could not certify, or None)."""
         a = np.ascontiguousarray(a, dtype=float)
+        r = self._rhs(state, a)
         if isinstance(rows, _Blocks):
-            return self._fallback(state, a, rows.A, rows.b)
+            return self._fallback(state, a, rows.A, rows.b, r)
         A, b = self._blocks(state)
         if b.size == 0:
             return np.zeros_like(a), np.zeros(0), 0, 0.0, 0.0
         ac = np.zeros(self._n)
         lam = np.zeros(b.size)
-        residual, scale, status = tree_solve(a, A, b, self._P, ac, lam)
+        residual, scale, status = tree_solve(a, r, A, b, self._P, ac, lam)
         if status == 0 and residual <= self.system.consistency_tol * scale:
             return ac, lam, b.size, float(residual), 0.0
         if status == 2 or not (all_finite(A) and all_finite(b)):
             self._not_finite(state)
-        return self._fallback(state, a, A, b)
+        return self._fallback(state, a, A, b, r)
 
-    def _fallback(self, state: State, a: FloatArray, A: FloatArray, b: FloatArray) -> Solution:
+    def _rhs(self, state: State, a: FloatArray) -> FloatArray:
+        """:func:`body_rhs` at ``state`` for the free acceleration ``a`` (zeros when no body
+        has a singular mass block), kept for :meth:`_constraint_wrench`."""
+        r = np.zeros(self._n)
+        if self.system._singular.any():
+            modeled, _ = self._loads(state)
+            V = np.ascontiguousarray(state.V, dtype=float)
+            body_rhs(V, np.ascontiguousarray(modeled, dtype=float), a, self._P, r)
+        self._last_rhs = r
+        return r
+
+    def _constraint_wrench(self, ac: FloatArray) -> FloatArray:
+        """Aᵀλ = M ν̇_c − r of the solve just made (r from :meth:`_rhs`: zero but for
+        bodies with a singular mass block)."""
+        return self.system._apply_M(ac) - self._last_rhs
+
+    def _fallback(
+        self, state: State, a: FloatArray, A: FloatArray, b: FloatArray, r: FloatArray
+    ) -> Solution:
         """The dense (QR, else SVD) or sparse solve of the same rows, which decides the rank
-        and warns on inconsistent rows as under those strategies."""
+        and warns on inconsistent rows as under those strategies; for a System with singular
+        mass blocks, the dense KKT system (:meth:`_singular_kkt`)."""
         system = self.system
         A_full = self._dense(A)
+        if system._singular.any():
+            return self._singular_kkt(state, a, A_full, b, r)
         if not system.sparse:
             Ms = system._Minv_sqrt
             rcond = system.rcond if system.rcond is not None else max(A_full.shape) * _EPS
@@ -856,3 +1133,34 @@ class TreeSolver(UKSolver):
         )
         self.check_consistency(state, residual, scale)
         return ac, lam, rank_sp, residual, 0.0
+
+    def _singular_kkt(
+        self, state: State, a: FloatArray, A: FloatArray, b: FloatArray, r: FloatArray
+    ) -> Solution:
+        """``[[M, Aᵀ], [A, 0]] [ν̇_c; μ] = [r; b − A a]`` solved densely, when the tree solve
+        cannot certify a System with singular mass blocks: its answer if the KKT matrix has
+        full rank (the motion is determined), a ConstraintError naming the state otherwise
+        (no minimum-norm choice stands in for a motion the equations leave free)."""
+        n, s = self._n, b.size
+        K = np.zeros((n + s, n + s))
+        K[:n, :n] = self.system.mass_matrix
+        K[:n, n:] = A.T
+        K[n:, :n] = A
+        rhs = np.concatenate([r, b - A @ a])
+        sv = np.linalg.svd(K, compute_uv=False)
+        if not sv[-1] > max(K.shape) * _EPS * sv[0]:
+            raise ConstraintError(
+                f"at t = {state.t:.9g} s the constrained equations are singular: bodies with "
+                "a singular mass block (allow_singular) have motions that neither their mass "
+                "nor their constraints determine (e.g. a massless link at the end of a chain)"
+            )
+        x = np.linalg.solve(K, rhs)
+        ac, lam = x[:n], -x[n:]
+        residual = float(np.linalg.norm(A @ (a + ac) - b))
+        scale = float(
+            consistency_scale(
+                np.sqrt(b @ b), np.sqrt(np.sum(A * A)), np.linalg.norm(a), np.linalg.norm(ac)
+            )
+        )
+        self.check_consistency(state, residual, scale)
+        return ac, lam, s, residual, 0.0

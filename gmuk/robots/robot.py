@@ -95,6 +95,36 @@ def _quat_xyzw(R: FloatArray) -> FloatArray:
     return np.asarray(quaternion_from_R_NB(R, scalar="last"), dtype=float)
 
 
+#: A link's principal moment at or below this fraction of the robot's largest is URDF
+#: round-off (iCub's zero inertias come out of Pinocchio at ±5e-20 kg·m²): it is set to zero.
+ROUND_OFF = 1e-12
+
+
+def _round_off_zeroed(J: FloatArray, largest: float) -> FloatArray:
+    """J with the principal moments at or below ``ROUND_OFF · largest`` (kg·m²) set to zero;
+    J itself when there is none."""
+    w, U = np.linalg.eigh(0.5 * (J + J.T))
+    small = np.abs(w) <= ROUND_OFF * largest
+    if not small.any():
+        return J
+    w[small] = 0.0
+    out = (U * w) @ U.T
+    return np.asarray(0.5 * (out + out.T))
+
+
+def _undetermined(model: Any) -> list[str]:
+    """The joints that move no mass at all (their subtree's links are all massless): their
+    acceleration is undetermined (Pinocchio's ABA gives NaN there too)."""
+    subtree = [float(model.inertias[i].mass) for i in range(model.njoints)]
+    for i in range(model.njoints - 1, 0, -1):  # children have larger indices
+        subtree[model.parents[i]] += subtree[i]
+    return [
+        f"joint {model.names[i]!r} moves only links without mass: its acceleration is undetermined"
+        for i in range(1, model.njoints)
+        if subtree[i] == 0.0
+    ]
+
+
 class Robot:
     """A tree of rigid bodies and joints built from a URDF (see the module docstring).
 
@@ -132,18 +162,29 @@ class Robot:
         problems: list[str] = []
         bodies: list[RigidBody] = []
         self._com: list[FloatArray] = [np.zeros(3)]
+        moments = [np.linalg.eigvalsh(model.inertias[i].inertia) for i in range(1, model.njoints)]
+        largest = max((float(np.max(np.abs(w))) for w in moments), default=0.0)
         for i in range(1, model.njoints):
             inertia = model.inertias[i]
             link = _first_link(model, i)
             try:
-                bodies.append(RigidBody(link, float(inertia.mass), np.array(inertia.inertia)))
+                bodies.append(
+                    RigidBody(
+                        link,
+                        float(inertia.mass),
+                        _round_off_zeroed(np.array(inertia.inertia), largest),
+                        allow_singular=True,
+                    )
+                )
             except GmukError as exc:
                 problems.append(f"joint {model.names[i]!r} (link {link!r}): {exc}")
             self._com.append(np.array(inertia.lever, dtype=float))
+        problems += _undetermined(model)
         if problems:
             raise DefinitionError(
-                "gmuk needs every link to have a positive mass and a positive-definite central "
-                "inertia (maximal coordinates: each link is a rigid body); " + "; ".join(problems)
+                "gmuk needs every link to have a physical inertia (mass ≥ 0, central inertia "
+                "positive semidefinite) and every joint to move some mass (maximal "
+                "coordinates: each link is a rigid body); " + "; ".join(problems)
             )
         self.bodies = tuple(bodies)
         self.joints: dict[str, Joint] = {}
@@ -227,8 +268,17 @@ class Robot:
         Raises
         ------
         DefinitionError
-            For a missing file, an unknown base, a joint gmuk does not build (it lists them)
-            or a link without a positive mass or a positive-definite inertia.
+            For a missing file, an unknown base, a joint gmuk does not build (it lists them),
+            a link whose inertia is not physical (negative mass or principal moment, moments
+            against the triangle inequality) or a joint that moves no mass.
+
+        Notes
+        -----
+        Links without mass or without rotational inertia (massless links between the
+        revolutes of a hip, point masses) are built with ``allow_singular=True`` and solved
+        by the tree solve, which eliminates each with the joint to its parent
+        (docs/robotics.rst, "Links without mass or rotational inertia"). A principal moment
+        at or below :data:`ROUND_OFF` times the robot's largest counts as zero.
         """
         pin = _pin()
         p = Path(path)

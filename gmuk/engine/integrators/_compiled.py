@@ -67,7 +67,7 @@ from gmuk.engine.integrators._program import (
     Program,
     reference_records,
 )
-from gmuk.engine.tree import TREE, constraint_block, kernel_rows, tree_pair, tree_solve
+from gmuk.engine.tree import TREE, body_rhs, constraint_block, kernel_rows, tree_pair, tree_solve
 from gmuk.forces.base import FORCE_KERNEL
 from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
 
@@ -322,9 +322,12 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
                 # the tree strategy's certified block LDLᵀ (TreeSolver.solve)
                 ac = aux[2 * ndof : 3 * ndof]
                 P = parts.uk_params
+                rhs = np.zeros(0)
                 if d.solve == TREE:
+                    rhs = np.empty(ndof)  # zero but for bodies with a singular mass block
+                    body_rhs(V, modeled, total, P, rhs)
                     residual, scale, status = tree_solve(
-                        total, A, b, P, ac, aux[4 * ndof : 4 * ndof + s]
+                        total, rhs, A, b, P, ac, aux[4 * ndof : 4 * ndof + s]
                     )
                 else:
                     Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
@@ -339,6 +342,8 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
                     aux[4 * ndof + s] = residual
                     aux[rank_at] = s
                     _apply_M(ac, J, m_r, m_e, r_off, e_off, aux[3 * ndof : 4 * ndof])
+                    for i in range(rhs.shape[0]):  # Aᵀλ = M ν̇_c − r
+                        aux[3 * ndof + i] -= rhs[i]
                     for i in range(ndof):
                         total[i] += ac[i]
         if not in_python:  # the controllers and the loads on the plant
