@@ -263,8 +263,10 @@ def tree_pair(P: np.ndarray, k: int) -> tuple[int, int]:
 
 @njit(cache=True, inline="always")
 def _cholesky(D: np.ndarray, d: int, sign: float, C: np.ndarray) -> bool:
-    """C (lower) with C Cᵀ = sign · D[:d, :d]; False when a pivot is not above PIVOT_TOL
-    times the largest diagonal entry (or not finite)."""
+    """C (lower) with C Cᵀ = sign · D[:d, :d], its diagonal stored as reciprocals 1/C_jj
+    (the solves multiply: a division's latency dominates these short dependent chains);
+    False when a pivot is not above PIVOT_TOL times the largest diagonal entry (or not
+    finite). Reads D's lower triangle only."""
     big = 0.0
     for i in range(d):
         big = max(big, sign * D[i, i])
@@ -277,29 +279,29 @@ def _cholesky(D: np.ndarray, d: int, sign: float, C: np.ndarray) -> bool:
             acc -= C[j, k] * C[j, k]
         if not acc > tol:
             return False
-        cjj = np.sqrt(acc)
-        C[j, j] = cjj
+        rjj = 1.0 / np.sqrt(acc)
+        C[j, j] = rjj
         for i in range(j + 1, d):
             acc = sign * D[i, j]
             for k in range(j):
                 acc -= C[i, k] * C[j, k]
-            C[i, j] = acc / cjj
+            C[i, j] = acc * rjj
     return True
 
 
 @njit(cache=True, inline="always")
 def _chol_solve(C: np.ndarray, d: int, sign: float, y: np.ndarray) -> None:
-    """y ← D⁻¹ y in place for D = sign · C Cᵀ (d × d)."""
+    """y ← D⁻¹ y in place for D = sign · C Cᵀ (d × d; C from :func:`_cholesky`)."""
     for i in range(d):
         acc = y[i]
         for k in range(i):
             acc -= C[i, k] * y[k]
-        y[i] = acc / C[i, i]
+        y[i] = acc * C[i, i]
     for i in range(d - 1, -1, -1):
         acc = y[i]
         for k in range(i + 1, d):
             acc -= C[k, i] * y[k]
-        y[i] = acc / C[i, i]
+        y[i] = acc * C[i, i]
     if sign < 0.0:
         for i in range(d):
             y[i] = -y[i]
@@ -435,6 +437,9 @@ def _eliminate_pair(i, k, p, nb, A, row0, body_a, dim, D, C, X, y):  # type: ign
     dk = dim[k]
     c = k - nb
     half = 0 if int(body_a[c]) == i else 6
+    for u in range(6):  # the elimination keeps the lower triangle: mirror it
+        for v in range(u + 1, 6):
+            D[i, u, v] = D[i, v, u]
     H = np.zeros((6, 6))
     for u in range(6):
         for v in range(dk):
@@ -483,6 +488,26 @@ def _eliminate_pair(i, k, p, nb, A, row0, body_a, dim, D, C, X, y):  # type: ign
             acc += A[row0[c] + q, hp + u] * y[k, q]
         y[p, u] -= acc
     return True
+
+
+@njit(cache=True, inline="always")
+def _coupling(i, p, nb, A, row0, body_a, dim, H):  # type: ignore[no-untyped-def]
+    """H_ip (d_i × d_p) into H: the rows of the constraint node on the body node (i body,
+    p constraint k: A_k[:, body i]ᵀ; i constraint k, p body: A_k[:, body p]). Returns d_p."""
+    dp = dim[p]
+    if i < nb:
+        k = p - nb
+        half = 0 if int(body_a[k]) == i else 6
+        for u in range(6):
+            for v in range(dp):
+                H[u, v] = A[row0[k] + v, half + u]
+    else:
+        k = i - nb
+        half = 0 if int(body_a[k]) == p else 6
+        for u in range(dim[i]):
+            for v in range(6):
+                H[u, v] = A[row0[k] + u, half + v]
+    return dp
 
 
 @njit(cache=True)
@@ -555,8 +580,8 @@ def tree_solve(
     for i in range(nb):
         dim[i] = 6
     D = np.zeros((nn, 6, 6))
-    C = np.zeros((nn, 6, 6))
-    X = np.zeros((nn, 6, 6))
+    C = np.empty((nn, 6, 6))
+    X = np.empty((nn, 6, 6))
     y = np.zeros((nn, 6))
     for i in range(nb):  # D_i = M_i = blkdiag(J_i, m_i I)
         for u in range(3):
@@ -568,7 +593,8 @@ def tree_solve(
         for e in range(6 * nb):
             y[e // 6, e % 6] = rhs[e]
     up = np.empty(nn, dtype=np.int64)  # the parent in the back-substitution
-    merged = np.zeros(nn, dtype=np.bool_)
+    merged = np.zeros(nn, dtype=np.bool_)  # a constraint node eliminated with its child
+    stored = np.zeros(nn, dtype=np.bool_)  # X_i = D_i⁻¹ H_ip kept (eliminated pairs)
     for i in range(nn):
         up[i] = int(parent[i])
     for k in range(nc):  # the joint nodes' right-hand side r_k = b_k − A_k a
@@ -583,8 +609,8 @@ def tree_solve(
                     acc -= A[row, 6 + e] * a[6 * ib + e]
             y[nb + k, u] = acc
     H = np.empty((6, 6))  # H_ip (d_i × d_p)
+    W = np.empty((6, 6))  # L_i⁻¹ H_ip
     col = np.empty(6)
-    w = np.empty(6)
     for step in range(nn):
         i = int(order[step])
         if merged[i]:
@@ -598,8 +624,10 @@ def tree_solve(
             k = int(parent[i])
             if not _eliminate_pair(i, k, int(parent[k]), nb, A, row0, body_a, dim, D, C, X, y):
                 return np.nan, np.nan, 1
-            merged[int(parent[i])] = True
-            up[i] = int(parent[int(parent[i])])
+            merged[k] = True
+            stored[i] = True
+            stored[k] = True
+            up[i] = int(parent[k])
             continue
         p = int(parent[i])
         # z_i = D_i⁻¹ y_i (y_i is final: every child has been subtracted)
@@ -607,52 +635,52 @@ def tree_solve(
             col[u] = y[i, u]
         _chol_solve(C[i], di, sign, col)
         if p >= 0:
-            dp = dim[p]
-            # H_ip: the rows of the constraint node on the body node
-            if i < nb:  # i body, p constraint k: H_ip = A_k[:, body i]ᵀ (6 × s_k)
-                k = p - nb
-                half = 0 if int(body_a[k]) == i else 6
-                for u in range(6):
-                    for v in range(dp):
-                        H[u, v] = A[row0[k] + v, half + u]
-            else:  # i constraint k, p body: H_ip = A_k[:, body p] (s_k × 6)
-                k = i - nb
-                half = 0 if int(body_a[k]) == p else 6
-                for u in range(di):
-                    for v in range(6):
-                        H[u, v] = A[row0[k] + u, half + v]
-            # X_i = D_i⁻¹ H_ip, column by column
-            for v in range(dp):
-                for u in range(di):
-                    w[u] = H[u, v]
-                _chol_solve(C[i], di, sign, w)
-                for u in range(di):
-                    X[i, u, v] = w[u]
-            # D_p −= H_ipᵀ X_i, y_p −= X_iᵀ y_i
-            for u in range(dp):
+            dp = _coupling(i, p, nb, A, row0, body_a, dim, H)
+            # D_p −= H_ipᵀ D_i⁻¹ H_ip = sign · Wᵀ W with W = L_i⁻¹ H_ip (D_i = sign · L_i L_iᵀ),
+            # its lower triangle (the Cholesky reads no other); y_p −= H_ipᵀ z_i
+            for u in range(di):  # row by row: the d_p columns are independent chains
+                r_uu = C[i, u, u]
                 for v in range(dp):
+                    acc = H[u, v]
+                    for q in range(u):
+                        acc -= C[i, u, q] * W[q, v]
+                    W[u, v] = acc * r_uu
+            for u in range(dp):
+                for v in range(u + 1):
                     acc = 0.0
                     for q in range(di):
-                        acc += H[q, u] * X[i, q, v]
-                    D[p, u, v] -= acc
+                        acc += W[q, u] * W[q, v]
+                    D[p, u, v] -= sign * acc
                 acc = 0.0
                 for q in range(di):
-                    acc += X[i, q, u] * y[i, q]
+                    acc += H[q, u] * col[q]
                 y[p, u] -= acc
         for u in range(di):
             y[i, u] = col[u]  # now z_i
-    # x_i = z_i − X_i x_p, roots first (y holds z, then x)
+    # x_i = z_i − D_i⁻¹ H_ip x_p (X_i x_p where stored), roots first (y holds z, then x)
     for step in range(nn - 1, -1, -1):
         i = int(order[step])
         p = up[i]
-        if p >= 0:
-            di = dim[i]
-            dp = dim[p]
+        if p < 0:
+            continue
+        di = dim[i]
+        dp = dim[p]
+        if stored[i]:
             for u in range(di):
                 acc = 0.0
                 for v in range(dp):
                     acc += X[i, u, v] * y[p, v]
                 y[i, u] -= acc
+            continue
+        _coupling(i, p, nb, A, row0, body_a, dim, H)
+        for u in range(di):
+            acc = 0.0
+            for v in range(dp):
+                acc += H[u, v] * y[p, v]
+            col[u] = acc
+        _chol_solve(C[i], di, 1.0 if i < nb else -1.0, col)
+        for u in range(di):
+            y[i, u] -= col[u]
     for i in range(nb):
         for e in range(6):
             ac[6 * i + e] = y[i, e]
