@@ -66,6 +66,7 @@ from gmuk.engine.solvers import (
     _writable,
 )
 from gmuk.errors import ConstraintError
+from gmuk.forces.base import FORCE_KERNEL
 
 if TYPE_CHECKING:
     from gmuk.engine.system import System
@@ -817,13 +818,70 @@ def tree_rows_rigid(
     return 0
 
 
+_call_force = kernel_caller(FORCE_KERNEL, "force model")
+
+
+@njit(cache=True)
+def rigid_loads(t, g, V, terms, params, fdata, P, Q):  # type: ignore[no-untyped-def]
+    """Q (6 n_b,) ← the sum of the compiled force terms' wrenches [τ; f] (N·m, N, body
+    frames) at the poses g (n_b, 4, 4) and twists V (n_b, 6): the table ``terms`` (n, 8) of
+    :func:`gmuk.engine.integrators._program.pack_terms` (kernel address, rigid, body, ν
+    offset, modeled, parameter start, field start, field end), each kernel called as the
+    compiled loop calls it, with the body's mass and inertia from P. Returns 0, or the status
+    of a kernel that failed."""
+    nb = V.shape[0]
+    J = P[_HEAD : _HEAD + 9 * nb].reshape((nb, 3, 3))
+    m = P[_HEAD + 18 * nb : _HEAD + 19 * nb]
+    for e in range(Q.shape[0]):
+        Q[e] = 0.0
+    w = np.empty(6)
+    for f in range(terms.shape[0]):
+        kernel, idx, off = terms[f, 0], terms[f, 2], terms[f, 3]
+        p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]
+        args = (True, t, g[idx], V[idx], m[idx], J[idx], params[p0:], fdata[f0:f1], w)
+        status = _call_force(kernel, args)
+        if status != 0:
+            return status
+        for i in range(6):
+            Q[off + i] += w[i]
+    return 0
+
+
+@njit(cache=True)
+def tree_loads_rows_rigid(t, g, V, terms, params, fdata, cons, cparams, P, A, b, out):  # type: ignore[no-untyped-def]
+    """:func:`rigid_loads`, then :func:`tree_rows_rigid`: one call from the state to the
+    accelerations, for a System whose force models and constraints all have a compiled
+    form and whose loads all go through the solve. Returns 0, or the status of a kernel that
+    failed (then ``out`` is not written)."""
+    Q = np.empty(6 * V.shape[0])
+    status = rigid_loads(t, g, V, terms, params, fdata, P, Q)
+    if status != 0:
+        return status
+    return tree_rows_rigid(t, g, V, Q, cons, cparams, P, A, b, out)
+
+
 _RW3 = types.Array(types.float64, 3, "C")
 _I2 = types.Array(types.int64, 2, "C")
+_RO1 = types.Array(types.float64, 1, "C", readonly=True)
 #: The signature of :func:`tree_rows_rigid` as the System calls it.
 TREE_ROWS_SIGNATURE = types.int64(
     types.float64, _RW3, _RW2, _RW1, _I2, _RW1, _RW1, _RW2, _RW1, _RW1
 )
+#: The signature of :func:`tree_loads_rows_rigid` as the System calls it.
+TREE_LOADS_SIGNATURE = types.int64(
+    types.float64, _RW3, _RW2, _I2, _RW1, _RO1, _I2, _RW1, _RW1, _RW2, _RW1, _RW1
+)
 _tree_rows_c: Any = None
+_tree_loads_c: Any = None  # the entry of tree_loads_rows_rigid
+
+
+def _tree_loads_entry() -> Any:
+    """The compiled entry of :func:`tree_loads_rows_rigid` for :data:`TREE_LOADS_SIGNATURE`."""
+    global _tree_loads_c
+    if _tree_loads_c is None:
+        tree_loads_rows_rigid.compile(TREE_LOADS_SIGNATURE)
+        _tree_loads_c = tree_loads_rows_rigid.overloads[TREE_LOADS_SIGNATURE.args].entry_point
+    return _tree_loads_c
 
 
 def _tree_rows_entry() -> Any:
@@ -940,6 +998,15 @@ class TreeSolver(UKSolver):
             self._cparams = np.array([*cparams, 0.0])
             self._s = r0
             _tree_rows_entry()
+        # every load compiled and seen by the solve: loads, rows and solve in one call
+        self._loads_table: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        if self._cons is not None and not system._plant_only_loads and not system.controllers:
+            from gmuk.engine.integrators import _program
+
+            plan, in_python = _program.force_terms(system._force_plan)
+            if not in_python and all(term[3] for term in plan):  # rigid bodies only
+                self._loads_table = _program.pack_terms(plan)
+                _tree_loads_entry()
         from gmuk.engine.system import _pair
 
         self._pair = _pair
@@ -1026,8 +1093,34 @@ class TreeSolver(UKSolver):
     # -- the solve
     def accelerations(self, state: State) -> Accelerations:
         """One compiled call (free acceleration, tree solve, wrenches) when nothing acts on
-        the plant beyond the solve; the general path otherwise."""
+        the plant beyond the solve, with the loads in it too when every force model is
+        compiled; the general path otherwise."""
         system = self.system
+        if self._loads_table is not None and self._cons is not None:
+            terms, params, fdata = self._loads_table
+            s, n = self._s, self._n
+            A, b = np.zeros((s, 12)), np.empty(s)
+            out = np.empty(4 * n + s + 3)
+            if (
+                _tree_loads_c(
+                    float(state.t),
+                    np.array(state.g, dtype=float),  # writable copies: the kernels' types
+                    np.array(state.V, dtype=float),
+                    terms,
+                    params,
+                    fdata,
+                    self._cons,
+                    self._cparams,
+                    self._P,
+                    A,
+                    b,
+                    out,
+                )
+                == 0
+                and out[-1] == _SOLVED
+            ):
+                return self._solved(out, s, self._zero_loads)
+            # a kernel failed or the call is not certified: the path below decides
         modeled, unmodeled = self._loads(state)
         if system._plant_only_loads:
             return self._general(state, modeled, unmodeled, None)
@@ -1064,26 +1157,32 @@ class TreeSolver(UKSolver):
                 tree_rigid(np.ascontiguousarray(V, dtype=float), modeled, A, b, self._P, out)
             status = float(out[-1])
         if status == _SOLVED:
-            return Accelerations._from_dict(
-                {
-                    "layout": self._lay,
-                    "free": out[:n],
-                    "constraint": out[n : 2 * n],
-                    "extra": self._zero_loads,
-                    "total": out[2 * n : 3 * n],
-                    "constraint_force": out[3 * n : 4 * n],
-                    "control_force": self._zero_loads,
-                    "unmodeled_force": unmodeled,
-                    "multipliers": out[4 * n : 4 * n + s] if s else _NO_MULTIPLIERS,
-                    "residual": float(out[-3]),
-                    "rank": s,
-                    "unreachable": 0.0,
-                    "z_dot": self._zero_z,
-                }
-            )
+            return self._solved(out, s, unmodeled)
         if status == _NOT_FINITE:
             self._not_finite(state)
         return self._general(state, modeled, unmodeled, _Blocks(A, b))
+
+    def _solved(self, out: FloatArray, s: int, unmodeled: FloatArray) -> Accelerations:
+        """The Accelerations of a certified compiled call (``out`` as :func:`tree_rigid`
+        writes it)."""
+        n = self._n
+        return Accelerations._from_dict(
+            {
+                "layout": self._lay,
+                "free": out[:n],
+                "constraint": out[n : 2 * n],
+                "extra": self._zero_loads,
+                "total": out[2 * n : 3 * n],
+                "constraint_force": out[3 * n : 4 * n],
+                "control_force": self._zero_loads,
+                "unmodeled_force": unmodeled,
+                "multipliers": out[4 * n : 4 * n + s] if s else _NO_MULTIPLIERS,
+                "residual": float(out[-3]),
+                "rank": s,
+                "unreachable": 0.0,
+                "z_dot": self._zero_z,
+            }
+        )
 
     def _not_finite(self, state: State) -> None:
         self.system.constraint_rows(state)  # raises ConstraintError naming the constraint

@@ -82,6 +82,33 @@ def test_tree_equals_dense_on_robots(name):
 
 
 @pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_compiled_loads_give_the_python_loads_numbers_bit_for_bit(name):
+    """Gravity alone (a compiled force model): one compiled call from the state (loads, rows,
+    solve) gives exactly the numbers of the compiled call that takes the loads summed in
+    Python, and the general path's to round-off; a model without a compiled form (joint
+    damping here) keeps the loads in Python."""
+    robot = _robot(name, solver="tree")
+    solver = robot.system.solver
+    table = solver._loads_table
+    assert table is not None
+    assert _robot(name, solver="tree", damping=0.7).system.solver._loads_table is None
+    rng = np.random.default_rng(31)
+    for _ in range(5):
+        q, v = _random_qv(robot.model, rng)
+        state = robot.state(q, v)
+        fast = robot.system.accelerations(state)
+        solver._loads_table = None
+        try:
+            python_loads = robot.system.accelerations(state)
+        finally:
+            solver._loads_table = table
+        general = solver._general(state, *solver._loads(state), None)
+        for field in FIELDS:
+            np.testing.assert_array_equal(getattr(fast, field), getattr(python_loads, field))
+        _assert_same(fast, general)
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS))
 def test_tree_joint_accelerations_equal_pinocchio_aba(name):
     robot = _robot(name, solver="tree")
     model = robot.model

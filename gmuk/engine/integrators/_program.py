@@ -330,9 +330,9 @@ def build(view: SystemView, method: RungeKuttaMethod, state: State) -> Program:
         if solve == FREE:
             rank = view.accelerations(state).rank
             free_rank = -1 if rank is None else int(rank)
-        terms_plan, py_forces = _force_plan(view)
+        terms_plan, py_forces = force_terms(view.force_plan)
         ctrl_plan, py_controllers = _controller_plan(view)
-    terms, params, field_data = _pack_terms(terms_plan)
+    terms, params, field_data = pack_terms(terms_plan)
     if solve == DENSE:  # DenseSolver.solve_rows: the QR's condition limit for these rows
         rcond = view.rcond
         if rcond is None:
@@ -388,13 +388,13 @@ def build(view: SystemView, method: RungeKuttaMethod, state: State) -> Program:
     return Program(parts, meth, 12 * nr + 2 * ne + nc, n_rows, python)
 
 
-def _force_plan(view: SystemView) -> tuple[list[tuple[Any, ...]], list[Any]]:
+def force_terms(force_plan: list[Any]) -> tuple[list[tuple[Any, ...]], list[Any]]:
     """The compiled terms ``(kernel, values, data, rigid, index, offset, modeled)`` of the force
-    models that have a compiled form on every body they act on, and the other models'
-    entries of the System's force plan (evaluated in Python)."""
+    models of a System's ``_force_plan`` that have a compiled form on every body they act
+    on, and the other models' entries (evaluated in Python)."""
     terms: list[tuple[Any, ...]] = []
     py_forces = []
-    for entry in view.force_plan:
+    for entry in force_plan:
         f, _bodies, slots = entry
         compiled_terms = [] if slots is None else [f._compiled_term(b) for b, *_ in slots]
         if slots is None or any(term is None for term in compiled_terms):
@@ -407,7 +407,7 @@ def _force_plan(view: SystemView) -> tuple[list[tuple[Any, ...]], list[Any]]:
     return terms, py_forces
 
 
-def _pack_terms(plan: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def pack_terms(plan: list[tuple[Any, ...]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The term table, parameters and shared field data of :func:`_force_plan`'s terms."""
     terms: list[list[int]] = []
     params: list[float] = []
