@@ -827,7 +827,7 @@ _add(
 _add(
     "docs/robotics.rst",
     "panda",
-    ("3.3e-10 rad", "pinocchio_max_q_difference_rad", "{:.1e} rad", "within"),
+    ("3.1e-10 rad", "pinocchio_max_q_difference_rad", "{:.1e} rad", "within"),
     ("84.5 J", "energy_dissipated_J", "{:.1f} J", "dissipate"),
 )
 
@@ -2486,20 +2486,21 @@ ALLOWED += [
 
 # docs/robotics.rst, "Speed: the tree solve" ----------------------------------------------------
 TIMINGS += [
-    ("docs/robotics.rst", "grows as n^0.99 from 5 to 1000 links", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "against n^2.29 for the dense solve up to 40", "bench_robots.py"),
-    ("docs/robotics.rst", "is 26–28 times ``pin.aba``", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "Panda, Solo12 and UR5 (72–169 times", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "and a 1 s Panda run 2.6 times", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "grows as n^0.87 from 5 to 1000 links", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "against n^2.48 for the dense solve up to 40", "bench_robots.py"),
+    ("docs/robotics.rst", "call is 7.2–8.9 times", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "UR5 (56–165 times", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "2.3 times Pinocchio's ABA", "bench_robots.py, 2026-11-29"),
     (
         "docs/robotics.rst",
-        "at the same tolerance (10 times with the dense solve)",
+        "at the same tolerance (8.5 times with the dense",
         "bench_robots.py",
     ),
+    ("docs/robotics.rst", "and 1.22–1.27 times MuJoCo's RK4", "bench_robots_mujoco.py, 2026-11-29"),
     (
         "docs/robotics.rst",
-        "rows taking 0.45 µs a joint",
-        "bench_robots.py --only parts, 2026-11-29",
+        "rows taking 0.6 µs a",
+        "bench_robots.py --only parts, 2026-11-29 (4.4 µs for the Panda's 7)",
     ),
 ]
 ALLOWED += [
