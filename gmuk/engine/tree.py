@@ -27,6 +27,15 @@ not certified to have full row rank, and the solve falls back to the dense
 (QR, else SVD) or the sparse strategy, which decide the rank and the minimum-norm solution.
 This is the maximal-coordinate counterpart of Featherstone's articulated-body algorithm.
 
+A body with a singular mass block (a link without mass, or a point mass:
+``RigidBody(allow_singular=True)``) has no free acceleration of its own: its free acceleration
+takes M⁺, the loads M⁺ leaves go on its node's right-hand side (:func:`body_rhs`), and when
+its D_i has no Cholesky factor it is eliminated together with the constraint to its parent as
+one node, by the null-space method on that constraint's rows (:func:`_eliminate_pair`); the
+KKT system keeps its tree, and the solve its linear cost. When every force model has a
+compiled form, :func:`tree_loads_rows_rigid` evaluates the loads, the rows and the solve in
+one compiled call.
+
 The multipliers are the Udwadia–Kalaba ones (``λ = (A M⁻¹ Aᵀ)⁻¹ (b − A ν̇_a)``, Eq. 3 of
 McCann 2020), the constraint acceleration ``ν̇_c = M⁻¹ Aᵀ λ`` (Eq. 64): for full row rank A
 the KKT solution is unique and equals the Moore–Penrose one of the dense solve.
