@@ -379,31 +379,33 @@ def _pair_solve(
     dk: int,
     f: np.ndarray,
     g: np.ndarray,
+    ws: np.ndarray,
 ) -> None:
     """[x; μ] = K⁻¹ [f; g] in place of (f, g) for K = [[D, H], [Hᵀ, 0]] (D 6 × 6, H 6 × dk)
     by the null-space method: with H = Q [R; 0] = Q₁R, x = Q₁R⁻ᵀg + Q₂y where
     N y = Q₂ᵀ(f − D Q₁R⁻ᵀg), N = Q₂ᵀ D Q₂ = L Lᵀ (the inertia along the motions joint k
-    allows, as in the articulated-body algorithm), and μ = R⁻¹ Q₁ᵀ (f − D x)."""
-    w = np.empty(6)
+    allows, as in the articulated-body algorithm), and μ = R⁻¹ Q₁ᵀ (f − D x). ``ws`` (4, 6)
+    is scratch space."""
+    w = ws[0]
     for u in range(dk):  # w = R⁻ᵀ g
         acc = g[u]
         for q in range(u):
             acc -= R[q, u] * w[q]
         w[u] = acc / R[u, u]
-    x = np.zeros(6)
+    x = ws[1]
     for e in range(6):
         acc = 0.0
         for u in range(dk):
             acc += Q[e, u] * w[u]
         x[e] = acc
-    t = np.empty(6)
+    t = ws[2]
     for e in range(6):  # t = f − D x₀
         acc = f[e]
         for q in range(6):
             acc -= D[e, q] * x[q]
         t[e] = acc
     nf = 6 - dk
-    yv = np.empty(6)
+    yv = ws[3]
     for u in range(nf):
         acc = 0.0
         for e in range(6):
@@ -471,7 +473,8 @@ def _eliminate_pair(i, k, p, nb, A, row0, body_a, dim, D, C, X, y):  # type: ign
     if not _cholesky(N, nf, 1.0, L):
         return False
     Di = D[i]
-    _pair_solve(Di, Q, R, L, dk, y[i], y[k])  # z_K
+    ws = np.empty((4, 6))
+    _pair_solve(Di, Q, R, L, dk, y[i], y[k], ws)  # z_K
     if p < 0:
         return True
     hp = 0 if int(body_a[c]) == p else 6
@@ -482,7 +485,7 @@ def _eliminate_pair(i, k, p, nb, A, row0, body_a, dim, D, C, X, y):  # type: ign
             f[u] = 0.0
         for u in range(dk):
             g[u] = A[row0[c] + u, hp + v]
-        _pair_solve(Di, Q, R, L, dk, f, g)
+        _pair_solve(Di, Q, R, L, dk, f, g, ws)
         for u in range(6):
             X[i, u, v] = f[u]
         for u in range(dk):
