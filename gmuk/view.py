@@ -4,11 +4,12 @@
 given), each body's path in the inertial frame N, and an animation (play button and time
 slider) of each rigid body's axes triad, the columns of R_NB, moving along its path; point
 masses are drawn as markers. A system with joints (:mod:`gmuk.robots`) is drawn as its
-kinematic skeleton too: each link a thick line from its body's centre to its joint frames'
-origins, and each joint frame's triad (see :func:`view_html`'s notes); a trajectory carries
-its joints to the view in its stats (:func:`with_joint_frames`, which the robot scenarios
-call), so that ``gmuk run`` and ``gmuk view`` draw them. :func:`write_view` writes the HTML to
-a file; ``gmuk view`` and ``gmuk run`` (``view.html`` beside the figures) call it.
+kinematic skeleton too: each link a capsule about the segments from its body's centre to its
+joint frames' origins, and each joint frame's triad (see :func:`view_html`'s notes); a
+trajectory carries its joints to the view in its stats (:func:`with_joint_frames`, which the
+robot scenarios call), so that ``gmuk run`` and ``gmuk view`` draw them. :func:`write_view`
+writes the HTML to a file; ``gmuk view`` and ``gmuk run`` (``view.html`` beside the figures)
+call it.
 
 Why plotly and not meshcat
 --------------------------
@@ -29,11 +30,14 @@ output index (the outputs of a gmuk run are evenly spaced in time), always keepi
 and last outputs. A self-contained view of one body is then about 5.1 MB whatever the run's
 length (a one-orbit FCEI run, 721 outputs: 5.10 MB), of which 4.8 MB is plotly.js; a view
 that loads a shared copy of it (``write_view(..., library=FOLDER)``, as ``gmuk run`` writes
-them) is about 0.3 MB.
+them) is about 0.3 MB. A robot's view is larger: each frame holds the vertices of every link's
+capsule (2 + 6 × 12 = 74 a link), as plotly.js typed arrays (base64 of the doubles, exact);
+the triangles are written once.
 """
 
 from __future__ import annotations
 
+import base64
 import json
 import os
 import sys
@@ -73,6 +77,28 @@ KM_ABOVE_M = 1.0e5
 #: Colour of the links of a system with joints, and of the ground's.
 LINK_COLOUR = "#5a82be"
 GROUND_COLOUR = "#505050"
+#: A drawn link is a capsule: rings of CAPSULE_SIDES vertices, CAPSULE_CAP_RINGS on each
+#: hemispherical cap (its rim included) and a vertex at each pole.
+CAPSULE_SIDES = 12
+CAPSULE_CAP_RINGS = 3
+#: The automatic link radius: this fraction of the robot's size (the largest distance between
+#: two points of its skeleton at the first drawn frame), and at least this fraction of the
+#: scene's, so that a small robot in a large scene still shows.
+LINK_RADIUS_OF_ROBOT = 0.03
+LINK_RADIUS_OF_SCENE = 0.004
+#: Flat shading of the capsules, lit from high above: their facets show their shape. Plotly
+#: drops the normal of a face whose normal's squared length (m⁴ in a scene in metres) is under
+#: ``facenormalsepsilon`` (default 1e-6), which leaves only the ambient light on the small faces
+#: of a capsule a few centimetres wide: every normal is kept.
+CAPSULE_LIGHTING = {
+    "ambient": 0.5,
+    "diffuse": 0.8,
+    "specular": 0.1,
+    "roughness": 0.5,
+    "facenormalsepsilon": 0.0,
+    "vertexnormalsepsilon": 0.0,
+}
+CAPSULE_LIGHT = {"x": 1e4, "y": -1e4, "z": 1e5}
 #: The key of :attr:`Trajectory.stats <gmuk.Trajectory.stats>` under which
 #: :func:`with_joint_frames` stores the joints a view draws (saved with the trajectory).
 JOINT_FRAMES_KEY = "joint_frames"
@@ -139,6 +165,98 @@ def _segment_trace(
     x, y, z = _segments(np.asarray(starts), np.asarray(ends))
     line: dict[str, Any] = {"width": width, **({} if colour is None else {"color": colour})}
     return dict(type="scatter3d", x=x, y=y, z=z, mode="lines", line=line, name=name)
+
+
+def _typed(values: Any) -> dict[str, str]:
+    """A float array as plotly.js's typed-array form (base64 of its little-endian doubles):
+    every bit kept, in 10.7 characters a number against about 19 for its decimal digits."""
+    raw = np.ascontiguousarray(values, dtype="<f8").ravel()
+    return {"dtype": "f8", "bdata": base64.b64encode(raw.tobytes()).decode("ascii")}
+
+
+def _capsules(starts: Any, ends: Any, radius: float, tiny: float) -> tuple[FloatArray, np.ndarray]:
+    """Closed triangle meshes of capsules: for each segment a → b (k, 3), the points at
+    distance ``radius`` from it, a cylinder about it closed by a hemisphere at each end.
+
+    Parameters
+    ----------
+    starts, ends : array_like (k, 3)
+        The segments' ends a and b (any length unit; ``radius`` and ``tiny`` in the same).
+    radius : float
+        ρ > 0.
+    tiny : float
+        A segment shorter than this (≥ 0) has no direction: it is drawn as the sphere of
+        radius ρ about a, its axis taken along the third axis.
+
+    Returns
+    -------
+    vertices : ndarray (k V, 3)
+        Capsule c's V = 2 + 2 n_r n_s vertices are rows c V … (c + 1) V − 1: the pole
+        a − ρ u (u = (b − a)/|b − a|), the cap rings about a from the pole to the rim, those
+        about b from the rim to the pole, and the pole b + ρ u. A cap ring at latitude
+        β = (π/2) j / n_r (j = 0 … n_r − 1: the rim first) has centre a − ρ sin β u (b + ρ sin β u)
+        and radius ρ cos β, its n_s = :data:`CAPSULE_SIDES` vertices at azimuths 2π i / n_s
+        about u from a unit normal e₁ of u (e₂ = u × e₁), with n_r = :data:`CAPSULE_CAP_RINGS`.
+    triangles : ndarray (k T, 3) of int
+        Rows of ``vertices``, counterclockwise seen from outside (T = 4 n_r n_s a capsule:
+        a fan at each pole and two triangles for each quad between consecutive rings; the
+        rims' band is the cylinder).
+    """
+    a = np.asarray(starts, dtype=float).reshape(-1, 3)
+    b = np.asarray(ends, dtype=float).reshape(-1, 3)
+    d = b - a
+    length = np.linalg.norm(d, axis=1)
+    along = length > tiny
+    u = np.where(along[:, None], d / np.where(along, length, 1.0)[:, None], [0.0, 0.0, 1.0])
+    # e1: u × (the basis vector least along u), normalised; e2 = u × e1
+    e1 = np.cross(u, np.eye(3)[np.argmin(np.abs(u), axis=1)])
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(u, e1)
+    n_s, n_r = CAPSULE_SIDES, CAPSULE_CAP_RINGS
+    beta = 0.5 * np.pi * np.arange(n_r) / n_r
+    side = np.concatenate([-np.ones(n_r), np.ones(n_r)])  # (2 n_r,): a's cap, then b's
+    lat = np.concatenate([beta[::-1], beta])
+    base = np.concatenate([np.repeat(a[:, None], n_r, 1), np.repeat(b[:, None], n_r, 1)], 1)
+    centres = base + (side * radius * np.sin(lat))[None, :, None] * u[:, None, :]
+    phi = 2.0 * np.pi * np.arange(n_s) / n_s
+    spoke = np.cos(phi)[:, None] * e1[:, None, :] + np.sin(phi)[:, None] * e2[:, None, :]
+    rings = centres[:, :, None, :] + (radius * np.cos(lat))[None, :, None, None] * spoke[:, None]
+    vertices = np.concatenate(
+        [(a - radius * u)[:, None], rings.reshape(len(a), -1, 3), (b + radius * u)[:, None]], 1
+    )
+    n_v = vertices.shape[1]
+    # one capsule's triangles: ring r's vertex i is 1 + r n_s + i
+    i = np.arange(n_s)
+    nxt = (i + 1) % n_s
+    last = n_v - 1
+    tri = [np.stack([np.zeros(n_s, int), 1 + nxt, 1 + i], 1)]  # the fan about a's pole
+    for r in range(2 * n_r - 1):
+        lo, hi = 1 + r * n_s, 1 + (r + 1) * n_s
+        tri += [np.stack([lo + i, lo + nxt, hi + nxt], 1), np.stack([lo + i, hi + nxt, hi + i], 1)]
+    rim = 1 + (2 * n_r - 1) * n_s
+    tri.append(np.stack([rim + i, rim + nxt, np.full(n_s, last)], 1))  # about b's pole
+    one = np.concatenate(tri)
+    triangles = (one[None] + n_v * np.arange(len(a))[:, None, None]).reshape(-1, 3)
+    return vertices.reshape(-1, 3), triangles
+
+
+def _capsule_trace(
+    starts: Any, ends: Any, radius: float, tiny: float, colour: str, name: str
+) -> dict[str, Any]:
+    """One plotly mesh3d trace of the capsules about the segments start→end (k, 3)."""
+    vertices, triangles = _capsules(starts, ends, radius, tiny)
+    return dict(
+        type="mesh3d",
+        **{c: _typed(vertices[:, n]) for n, c in enumerate("xyz")},
+        **{c: triangles[:, n].tolist() for n, c in enumerate("ijk")},
+        color=colour,
+        flatshading=True,
+        lighting=CAPSULE_LIGHTING,
+        lightposition=CAPSULE_LIGHT,
+        showlegend=True,
+        hoverinfo="skip",
+        name=name,
+    )
 
 
 # --- joints: the links and the joint frames ------------------------------------------------------
@@ -283,6 +401,7 @@ def view_html(
     joints: System | Sequence[Constraint] | None = None,
     draw_joint_frames: bool = True,
     joint_triad_length: float | None = None,
+    link_radius: float | None = None,
 ) -> str:
     """The HTML page of an interactive, offline 3-D view of ``traj``.
 
@@ -317,6 +436,10 @@ def view_html(
         Length (m) of each drawn joint frame axis; default 12 % of the mechanism's size (the
         largest extent, over the animation's frames, of its joint frame origins and the
         centres of the bodies they join).
+    link_radius : float, optional
+        Radius ρ (m) of the capsules drawn for the links; default 3 % of the robot's size at
+        the first drawn frame (the largest distance between two of its joint frame origins
+        and the centres of the bodies they join), and at least 0.4 % of the scene's.
 
     Returns
     -------
@@ -334,12 +457,15 @@ def view_html(
     Notes
     -----
     A system with joints (gmuk.robots joints between two bodies, or a body and the ground) is
-    drawn as its kinematic skeleton, animated with the bodies: each link is a thick line
-    from its body's centre (its body-frame origin) to the origin of each joint frame fixed in
-    it, ``g_NP X_PJ`` for the joints it is the parent of and ``g_NC X_CJ`` for those it is
-    the child of; the ground's link runs from N's origin to its joints' frames ``X_PJ``. Each
-    joint frame J_c (the child's, which moves with the joint) is drawn as a short triad of its
-    axes 1, 2, 3 in red, green and blue.
+    drawn as its kinematic skeleton, animated with the bodies: each link is a capsule of
+    radius ρ (``link_radius``: the points within ρ of a segment, a cylinder closed by two
+    hemispheres, drawn as a low-poly mesh) about each segment from its body's centre (its
+    body-frame origin) to the origin of a joint frame fixed in it, ``g_NP X_PJ`` for the
+    joints it is the parent of and ``g_NC X_CJ`` for those it is the child of; the ground's
+    link, grey, runs from N's origin to its joints' frames ``X_PJ``. A segment of no length
+    (a joint frame at its body's centre) is a sphere of radius ρ. Each joint frame J_c (the
+    child's, which moves with the joint) is drawn as a short triad of its axes 1, 2, 3 in
+    red, green and blue.
     """
     import plotly.io
 
@@ -355,6 +481,7 @@ def view_html(
         ("central_radius", central_radius),
         ("triad_length", triad_length),
         ("joint_triad_length", joint_triad_length),
+        ("link_radius", link_radius),
     ):
         try:
             if value is not None:
@@ -383,6 +510,8 @@ def view_html(
         robot_size = float(np.ptp(skeleton, axis=1).max())
         robot_size = robot_size if robot_size > 1e-6 else 1.0
         joint_length = joint_triad_length if joint_triad_length is not None else 0.12 * robot_size
+        # the largest distance between two points of the skeleton at the first drawn frame
+        reach = float(np.linalg.norm(skeleton[0][:, None] - skeleton[0][None], axis=2).max())
     size = float(np.ptp(allpos, axis=0).max()) if len(allpos) > 1 else 0.0
     if central_radius:  # the diameter, at most float64's largest (a radius near 1e308)
         central_radius = float(central_radius)
@@ -392,6 +521,11 @@ def view_html(
     length = triad_length if triad_length is not None else 0.12 * size
     if jointed and triad_length is None:  # the joint frames' triads stand out, the bodies' less
         length = 0.5 * joint_length
+    rho = 0.0  # the links' radius (m)
+    if jointed:
+        auto = max(LINK_RADIUS_OF_ROBOT * reach, LINK_RADIUS_OF_SCENE * size)
+        rho = auto if link_radius is None else float(link_radius)
+    tiny = 1e-12 * size  # a shorter segment is drawn as a sphere (m)
 
     traces: list[Any] = []
     if central_radius:
@@ -427,12 +561,17 @@ def view_html(
     grounded = [k for k, j in enumerate(jointed) if j.parent is None]
     if grounded:  # the ground's link: fixed
         ends = np.array([jointed[k].X_PJ[:3, 3] for k in grounded]) * scale
-        traces.append(_segment_trace(np.zeros_like(ends), ends, GROUND_COLOUR, 12, "ground"))
+        traces.append(
+            _capsule_trace(
+                np.zeros_like(ends), ends, rho * scale, tiny * scale, GROUND_COLOUR, "ground"
+            )
+        )
     first_dynamic = len(traces)
 
-    def skeleton_at(f: int) -> list[Any]:
-        """The links (one trace) and the joint frames' triads (one trace per axis) at the
-        kept frame ``f``."""
+    def skeleton_at(f: int, page: bool) -> list[Any]:
+        """The links' capsules (one trace) and the joint frames' triads (one trace per axis)
+        at the kept frame ``f``; the capsules' triangles in the page's data only (``page``),
+        which the frames' vertices move."""
         starts, ends = [], []
         for k, joint in enumerate(jointed):
             if joint.parent is not None:
@@ -440,11 +579,17 @@ def view_html(
                 ends.append(g_NJp[f, k, :3, 3])
             starts.append(r_C[f, k])
             ends.append(g_NJc[f, k, :3, 3])
-        out = [
-            _segment_trace(
-                np.array(starts) * scale, np.array(ends) * scale, LINK_COLOUR, 12, "links"
-            )
-        ]
+        links = _capsule_trace(
+            np.array(starts) * scale,
+            np.array(ends) * scale,
+            rho * scale,
+            tiny * scale,
+            LINK_COLOUR,
+            "links",
+        )
+        if not page:
+            links = {key: links[key] for key in ("type", "x", "y", "z", "name")}
+        out = [links]
         if draw_joint_frames:
             origins = g_NJc[f, :, :3, 3] * scale
             for axis in range(3):
@@ -454,9 +599,9 @@ def view_html(
                 )
         return out
 
-    def dynamic(f: int) -> list[Any]:
+    def dynamic(f: int, page: bool = False) -> list[Any]:
         """The triads (one trace per axis, all rigid bodies), the markers and the skeleton at
-        the kept frame ``f``."""
+        the kept frame ``f``: the page's initial data (``page``) or an animation frame's."""
         i = int(frame_idx[f])
         out = []
         rigid = [(r[i], R[i]) for _, r, R in bodies if R is not None]
@@ -481,7 +626,7 @@ def view_html(
                 name="bodies",
             )
         )
-        return out + (skeleton_at(f) if jointed else [])
+        return out + (skeleton_at(f, page) if jointed else [])
 
     n_dynamic = 4 + (1 + 3 * draw_joint_frames if jointed else 0)
     names = [f"{traj.t[i]:.6g}" for i in frame_idx]
@@ -500,7 +645,8 @@ def view_html(
         lo, hi = allpos.min(axis=0), allpos.max(axis=0)
         if central_radius:  # the sphere, about N's origin, in the box too
             lo, hi = np.minimum(lo, -central_radius), np.maximum(hi, central_radius)
-        half = np.maximum(0.5 * (hi - lo), 0.25 * float((hi - lo).max())) + joint_length
+        half = np.maximum(0.5 * (hi - lo), 0.25 * float((hi - lo).max()))
+        half += max(joint_length, rho)
         ranges = [
             {"range": [(c - h) * scale, (c + h) * scale], "autorange": False}
             for c, h in zip(0.5 * (lo + hi), half, strict=True)
@@ -568,7 +714,7 @@ def view_html(
     # the view's time (0.8 of 1.15 s for a 150-frame FCEI view)
     # the default template, which a plotly Figure would have applied
     layout["template"] = plotly.io.templates[plotly.io.templates.default].to_plotly_json()
-    fig = {"data": traces + dynamic(0), "frames": frames, "layout": layout}
+    fig = {"data": traces + dynamic(0, page=True), "frames": frames, "layout": layout}
     html: str = plotly.io.to_html(
         fig,
         validate=False,
@@ -650,7 +796,8 @@ def write_view(
         copy, and a page moved away from it says so when opened.
     **options
         ``triad_length`` (m), ``max_frames``, ``max_path_points``, ``joints``,
-        ``draw_joint_frames``, ``joint_triad_length`` (m), as :func:`view_html`.
+        ``draw_joint_frames``, ``joint_triad_length`` (m), ``link_radius`` (m), as
+        :func:`view_html`.
 
     Raises
     ------

@@ -1,11 +1,12 @@
-"""The 3-D view of a system with joints (issue #28, item 5): each link a thick line from its
-body's centre to the origins of the joint frames fixed in it, the ground's link from N's origin,
-and each joint frame J_c's axes triad, animated with the trajectory; the robot scenarios hand
-their joints to the view; headless Chromium renders and animates the page with no JavaScript
-error."""
+"""The 3-D view of a system with joints (issue #28, item 5): each link a capsule about the
+segments from its body's centre to the origins of the joint frames fixed in it, the ground's link
+from N's origin, and each joint frame J_c's axes triad, animated with the trajectory; the robot
+scenarios hand their joints to the view; headless Chromium renders and animates the page with no
+JavaScript error."""
 
 from __future__ import annotations
 
+import base64
 import json
 import re
 import subprocess
@@ -24,6 +25,8 @@ from gmuk.trajectory import load_trajectory
 from gmuk.view import (
     JOINT_FRAMES_KEY,
     LINK_COLOUR,
+    LINK_RADIUS_OF_ROBOT,
+    LINK_RADIUS_OF_SCENE,
     decimate,
     joint_frames,
     view_html,
@@ -83,11 +86,17 @@ def arm() -> tuple[gmuk.System, gmuk.Trajectory]:
     return robot.system, trajectory_through(states)
 
 
+def no_constant(name: str) -> None:
+    raise AssertionError(f"the page's data hold {name}")
+
+
 def figure(page: str) -> tuple[list[dict], list[dict]]:
-    """(data, frames) of a view page."""
+    """(data, frames) of a view page; a NaN or an infinity in them fails."""
     plot = r"Plotly\.newPlot\(\s*\"[^\"]+\",\s*(\[.*?\]),\s*\{"
     add = r"Plotly\.addFrames\(\s*['\"][^'\"]+['\"],\s*(\[.*\])\);"
-    return json.loads(re.search(plot, page, re.S)[1]), json.loads(re.search(add, page, re.S)[1])
+    data, frames = (json.loads(re.search(x, page, re.S)[1], parse_constant=no_constant)
+                    for x in (plot, add))  # fmt: skip
+    return data, frames
 
 
 def segments(trace: dict) -> np.ndarray:
@@ -101,6 +110,75 @@ def segments(trace: dict) -> np.ndarray:
 def named(traces: list[dict], name: str) -> dict:
     (trace,) = [t for t in traces if t.get("name") == name]
     return trace
+
+
+def numbers(values: list | dict) -> np.ndarray:
+    """A trace's coordinates: a list, or plotly.js's typed-array form (base64 of doubles)."""
+    if isinstance(values, dict):
+        assert values["dtype"] == "f8"
+        return np.frombuffer(base64.b64decode(values["bdata"]), dtype="<f8")
+    return np.array(values, dtype=float)
+
+
+def mesh(trace: dict, first: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The vertices (n, 3) and triangles (t, 3) of a mesh3d trace; an animation frame's trace
+    moves the vertices of ``first``, the page's trace, whose triangles it keeps."""
+    assert trace["type"] == "mesh3d"
+    vertices = np.stack([numbers(trace[c]) for c in "xyz"], axis=1)
+    faces = first if first is not None else trace
+    triangles = np.array([faces[c] for c in "ijk"]).T
+    assert triangles.dtype.kind == "i"
+    return vertices, triangles
+
+
+def distance_to_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance from each point p (n, 3) to the segment a b (a point if a = b)."""
+    d = b - a
+    dd = float(d @ d)
+    t = np.clip((p - a) @ d / dd, 0.0, 1.0) if dd > 0 else np.zeros(len(p))
+    return np.linalg.norm(p - (a + t[:, None] * d), axis=1)
+
+
+def pieces(trace: dict) -> int:
+    """The number of separate surfaces of a mesh3d trace (connected by its triangles)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    vertices, triangles = mesh(trace)
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]]])
+    n = len(vertices)
+    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
+    return int(connected_components(graph, directed=False)[0])
+
+
+def check_capsules(trace: dict, first: dict | None, links: np.ndarray, rho: float) -> None:
+    """``trace`` draws one closed capsule of radius rho about each segment of ``links``
+    (k, 2, 3), in order: each capsule's vertices at distance rho from its segment, its caps
+    reaching rho beyond the segment's ends along it, its triangles a closed surface."""
+    vertices, triangles = mesh(trace, first)
+    assert np.isfinite(vertices).all()
+    n_caps = len(links)
+    assert n_caps > 0 and len(vertices) % n_caps == 0  # one capsule a segment, all alike
+    per = len(vertices) // n_caps
+    assert triangles.min() >= 0 and triangles.max() < len(vertices)
+    # each triangle joins three vertices of one capsule, each capsule has as many
+    owner = triangles // per
+    assert (owner == owner[:, :1]).all()
+    assert np.array_equal(
+        np.bincount(owner[:, 0], minlength=n_caps), [len(triangles) // n_caps] * n_caps
+    )
+    # closed and consistently oriented: each directed edge once, its reverse once
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    assert len({tuple(e) for e in edges}) == len(edges)
+    assert {tuple(e) for e in edges} == {(b, a) for a, b in edges}
+    for c, (a, b) in enumerate(links):
+        p = vertices[c * per : (c + 1) * per]
+        np.testing.assert_allclose(distance_to_segment(p, a, b), rho, rtol=1e-12, atol=0)
+        length = np.linalg.norm(b - a)
+        if length > 0:  # the caps: rho beyond each end, along the segment
+            u = (b - a) / length
+            assert abs(((p - b) @ u).max() - rho) <= 1e-12 * rho
+            assert abs(((p - a) @ u).min() + rho) <= 1e-12 * rho
 
 
 def expected_skeleton(system: gmuk.System, state: gmuk.State, length: float):
@@ -123,29 +201,93 @@ def expected_skeleton(system: gmuk.System, state: gmuk.State, length: float):
 
 
 @pytest.mark.parametrize("which", ["linkage", "arm"])
-def test_links_end_at_the_joint_frames_at_every_frame(which, request):
+def test_the_links_are_capsules_about_the_joint_frames_at_every_frame(which, request):
     system, traj = request.getfixturevalue(which)
-    length = 0.05
-    page = view_html(traj, joints=system, max_frames=7, joint_triad_length=length)
+    length, rho = 0.05, 0.02
+    page = view_html(traj, joints=system, max_frames=7, joint_triad_length=length, link_radius=rho)
     data, frames = figure(page)
     kept = decimate(len(traj), 7)
     assert [f["name"] for f in frames] == [f"{traj.t[i]:.6g}" for i in kept]
+    page_links = named(data, "links")
     for f, i in enumerate(kept):
         links, axes, ground = expected_skeleton(system, traj.state(int(i)), length)
         drawn = frames[f]["data"]
-        # metres (the scene is under 100 km): equal to round-off
-        np.testing.assert_allclose(segments(named(drawn, "links")), links, rtol=0, atol=1e-12)
+        # metres (the scene is under 100 km): capsules about the segments to round-off
+        check_capsules(named(drawn, "links"), page_links, links, rho)
         for a in range(3):
             np.testing.assert_allclose(
                 segments(named(drawn, f"joint axis {a + 1}")), axes[a], rtol=0, atol=1e-12
             )
         if f == 0:  # the first frame is the page's initial data
-            np.testing.assert_allclose(segments(named(data, "links")), links, rtol=0, atol=1e-12)
-    if len(ground):  # the four-bar: O2 and O4; the Panda: its base
-        np.testing.assert_allclose(segments(named(data, "ground")), ground, rtol=0, atol=0)
+            check_capsules(page_links, None, links, rho)
+            assert named(drawn, "links") == {k: page_links[k] for k in named(drawn, "links")}
+        assert "i" not in named(drawn, "links")  # the frames move the page's mesh
+    if len(ground):  # the four-bar: O2 and O4; the Panda: its base (a sphere: at N's origin)
+        check_capsules(named(data, "ground"), None, ground, rho)
     # the links move: the middle frame's differ from the first's
-    first, middle = (segments(named(frames[k]["data"], "links")) for k in (0, 3))
+    first, middle = (mesh(named(frames[k]["data"], "links"), page_links)[0] for k in (0, 3))
     assert np.abs(first - middle).max() > 0.05
+
+
+def robot_reach(system: gmuk.System, state: gmuk.State) -> float:
+    """The largest distance between two of the joint frame origins and the centres of the
+    bodies they join (N's origin for the ground)."""
+    points = []
+    for joint in system.constraints:
+        if isinstance(joint, Joint):
+            g_NP = np.eye(4) if joint.parent is None else state.pose(joint.parent)
+            g_NC = state.pose(joint.child)
+            points += [g_NP[:3, 3], g_NC[:3, 3]]
+            points += [(g_NP @ joint.parent_frame)[:3, 3], (g_NC @ joint.child_frame)[:3, 3]]
+    p = np.array(points)
+    return max(float(np.linalg.norm(p - q, axis=1).max()) for q in p)
+
+
+@pytest.mark.parametrize("which", ["linkage", "arm"])
+def test_the_automatic_link_radius_is_a_fraction_of_the_robot_or_of_the_scene(which, request):
+    system, traj = request.getfixturevalue(which)
+    later = trajectory_through([traj.state(i) for i in range(5, len(traj))])
+    radii = []
+    for shown in (traj, later):  # the robot at the first drawn frame, for every frame
+        data, frames = figure(view_html(shown, joints=system, max_frames=4))
+        rho = LINK_RADIUS_OF_ROBOT * robot_reach(system, shown.state(0))
+        for f, i in enumerate(decimate(len(shown), 4)):
+            links, _, _ = expected_skeleton(system, shown.state(int(i)), 1.0)
+            check_capsules(named(frames[f]["data"], "links"), named(data, "links"), links, rho)
+        radii.append(rho)
+        assert 0.005 < rho < 0.05  # m: a few centimetres for a robot about a metre across
+    assert radii[0] != radii[1]
+    # beside a body 200 m wide, the robot is small: its links 0.4 % of the scene
+    links, _, ground = expected_skeleton(system, traj.state(0), 1.0)
+    data, _ = figure(view_html(traj, joints=system, central_radius=100.0))
+    check_capsules(named(data, "links"), None, links, LINK_RADIUS_OF_SCENE * 200.0)
+    # a scene over 100 km is drawn in km, the capsules too
+    data, _ = figure(view_html(traj, joints=system, central_radius=1e6))
+    rho = LINK_RADIUS_OF_SCENE * 2e6
+    check_capsules(named(data, "links"), None, links * 1e-3, rho * 1e-3)
+    check_capsules(named(data, "ground"), None, ground * 1e-3, rho * 1e-3)
+
+
+def test_a_link_of_no_length_is_a_sphere(linkage):
+    """A joint frame at its body's centre: the child's segment has no length; its capsule is
+    the sphere of radius rho about the point, with no NaN in the page."""
+    system, traj = linkage
+    records = joint_frames(system)
+    X_CJ = np.array(records[1]["X_CJ"])
+    X_CJ[:3, 3] = 0.0  # joint A's frame at the coupler's centre
+    records[1] = {**records[1], "X_CJ": X_CJ.tolist()}
+    odd = replace(traj, stats={JOINT_FRAMES_KEY: records})
+    data, frames = figure(view_html(odd, link_radius=0.03))
+    vertices, _ = mesh(named(data, "links"))
+    # the crank's two segments, then the coupler's, whose centre is now also its end
+    per = len(vertices) // 6
+    sphere = vertices[2 * per : 3 * per]
+    centre = odd.state(0).pose("coupler")[:3, 3]
+    np.testing.assert_allclose(np.linalg.norm(sphere - centre, axis=1), 0.03, rtol=1e-12)
+    assert np.isfinite(mesh(named(data, "ground"))[0]).all()
+    for fr in frames:
+        assert np.isfinite(mesh(named(fr["data"], "links"), named(data, "links"))[0]).all()
+    assert pieces(named(data, "links")) == 6
 
 
 def test_the_number_of_traces_is_the_paths_the_ground_and_the_moving_parts(linkage, arm):
@@ -162,14 +304,14 @@ def test_the_number_of_traces_is_the_paths_the_ground_and_the_moving_parts(linka
         ]
         assert all(fr["traces"] == list(range(static, static + moving)) for fr in frames)
         assert all(len(fr["data"]) == moving for fr in frames)
-        # two segments for a joint between bars (A, B), one for a joint to the ground
-        assert len(segments(named(data, "links"))) == 2 + 2 + 1 + 1
-        assert len(segments(named(data, "ground"))) == 2
+        # two capsules for a joint between bars (A, B), one for a joint to the ground
+        assert pieces(named(data, "links")) == 2 + 2 + 1 + 1
+        assert pieces(named(data, "ground")) == 2
     # the Panda: seven links' paths, its base on the ground; seven joints, one to the ground
     system, traj = arm
     data, _ = figure(view_html(traj, joints=system))
     assert len(data) == 7 + 1 + 8
-    assert len(segments(named(data, "links"))) == 2 * 6 + 1
+    assert pieces(named(data, "links")) == 2 * 6 + 1
     # a trajectory without joints is drawn as before: paths, body axes, markers
     plain, _ = figure(view_html(traj))
     assert [t["name"] for t in plain[7:]] == [
@@ -243,7 +385,7 @@ def test_the_robot_scenarios_hand_their_joints_to_gmuk_runs_view(
     data, _ = figure(page.read_text())
     drawn = [t["name"] for t in data]
     assert "ground" in drawn and "links" in drawn and "joint axis 3" in drawn
-    assert len(segments(named(data, "links"))) == 2 * n_joints - n_grounded
+    assert pieces(named(data, "links")) == 2 * n_joints - n_grounded
 
 
 # --- headless Chromium --------------------------------------------------------------------------
@@ -288,9 +430,15 @@ def error_and_dom(chromium: str, path: Path, profile: Path) -> tuple[str | None,
 
 
 def link_pixels(image: np.ndarray) -> int:
-    """Pixels of the links' colour, LINK_COLOUR (#rrggbb), to within 12 in each channel."""
+    """Pixels of a lit shade of the links' colour, LINK_COLOUR (#rrggbb) = c: s c, each
+    channel's ratio to c within 4 % of their mean s, 0.6 < s < 1.3. The capsules' facets
+    facing the light are near s = 1; those in the ambient light alone (s = 0.5) are left out,
+    as is plotly's text colour (#2a3f5f, 0.48 c)."""
     colour = np.array([int(LINK_COLOUR[k : k + 2], 16) for k in (1, 3, 5)])
-    return int((np.abs(image - colour).max(axis=2) < 12).sum())
+    ratio = image / colour
+    s = ratio.mean(axis=2)
+    shade = np.abs(ratio - s[..., None]).max(axis=2) < 0.04 * s
+    return int((shade & (s > 0.6) & (s < 1.3)).sum())
 
 
 def test_chromium_draws_and_animates_a_robot_view_with_no_script_error(chromium, tmp_path, arm):
@@ -312,7 +460,8 @@ def test_chromium_draws_and_animates_a_robot_view_with_no_script_error(chromium,
     )
     error, _ = error_and_dom(chromium, tmp_path / "bad.html", tmp_path / "p2")
     assert error is not None and "null" in error, error
-    # the links are drawn: thousands of pixels of their colour, none in the same view without
+    # the links are drawn, and lit: thousands of pixels of lit shades of their colour, none in
+    # the same view without joints
     image, requests = render(chromium, write_view(traj, tmp_path / "v.html", joints=system),
                              tmp_path / "v.png")  # fmt: skip
     bare, _ = render(chromium, write_view(traj, tmp_path / "b.html"), tmp_path / "b.png")
