@@ -170,6 +170,10 @@ class RigidBody(Body):
     ) -> None:
         name = _check_name(name)
         label = f"RigidBody {name!r}"
+        if not isinstance(allow_singular, (bool, np.bool_)):
+            raise DefinitionError(
+                f"{label}: allow_singular must be True or False; got {allow_singular!r}"
+            )
         try:
             m, J = check_inertia(mass, inertia, name=label, allow_singular=bool(allow_singular))
         except InertiaError as exc:

@@ -250,6 +250,23 @@ def test_allow_singular_still_refuses_what_is_not_physical(mass, J, words):
         gmuk.RigidBody("x", mass, J, allow_singular=True)
 
 
+def test_allow_singular_takes_a_bool_only():
+    with pytest.raises(DefinitionError, match="allow_singular must be True or False"):
+        gmuk.RigidBody("x", 0.0, np.zeros((3, 3)), allow_singular="yes")
+
+
+def test_a_massless_floating_link_is_undetermined_and_says_so():
+    """A massless body with no joint to hold it: nothing determines its motion."""
+    base = _heavy("base")
+    ghost = _massless("ghost")
+    system = gmuk.System([base, ghost], [RevoluteJoint(None, base)], solver="tree")
+    state = system.state(
+        {"base": np.eye(4), "ghost": np.eye(4)}, {"base": np.zeros(6), "ghost": np.zeros(6)}
+    )
+    with pytest.raises(ConstraintError, match="singular"):
+        system.accelerations(state)
+
+
 def test_a_singular_body_is_refused_by_default():
     with pytest.raises(InertiaError, match="mass must be"):
         gmuk.RigidBody("x", 0.0, np.zeros((3, 3)))
