@@ -504,10 +504,9 @@ def _eliminate_pair(i, k, p, nb, A, row0, body_a, dim, D, C, X, y):  # type: ign
 
 
 @njit(cache=True, inline="always")
-def _coupling(i, p, nb, A, row0, body_a, dim, H):  # type: ignore[no-untyped-def]
+def _coupling(i, p, di, dp, nb, A, row0, body_a, H):  # type: ignore[no-untyped-def]
     """H_ip (d_i × d_p) into H: the rows of the constraint node on the body node (i body,
-    p constraint k: A_k[:, body i]ᵀ; i constraint k, p body: A_k[:, body p]). Returns d_p."""
-    dp = dim[p]
+    p constraint k: A_k[:, body i]ᵀ; i constraint k, p body: A_k[:, body p])."""
     if i < nb:
         k = p - nb
         half = 0 if int(body_a[k]) == i else 6
@@ -517,10 +516,60 @@ def _coupling(i, p, nb, A, row0, body_a, dim, H):  # type: ignore[no-untyped-def
     else:
         k = i - nb
         half = 0 if int(body_a[k]) == p else 6
-        for u in range(dim[i]):
+        for u in range(di):
             for v in range(6):
                 H[u, v] = A[row0[k] + u, half + v]
-    return dp
+
+
+@njit(cache=True, inline="always")
+def _eliminate_node(i, p, di, dp, sign, nb, A, row0, body_a, D, C, H, W, y, col):  # type: ignore[no-untyped-def]
+    """One step of the block LDLᵀ for node i (d_i) with parent p (d_p; −1: a root): the
+    Cholesky factor of D_i, z_i = D_i⁻¹ y_i into y[i], and the parent's update
+    D_p −= H_ipᵀ D_i⁻¹ H_ip = sign · Wᵀ W with W = L_i⁻¹ H_ip (D_i = sign · L_i L_iᵀ; its lower
+    triangle, which is all the Cholesky reads), y_p −= H_ipᵀ z_i. False, with nothing but
+    C[i] written, when D_i is not certified."""
+    if not _cholesky(D[i], di, sign, C[i]):
+        return False
+    for u in range(di):  # z_i (y_i is final: every child has been subtracted)
+        col[u] = y[i, u]
+    _chol_solve(C[i], di, sign, col)
+    if p >= 0:
+        _coupling(i, p, di, dp, nb, A, row0, body_a, H)
+        for u in range(di):  # row by row: the d_p columns are independent chains
+            r_uu = C[i, u, u]
+            for v in range(dp):
+                acc = H[u, v]
+                for q in range(u):
+                    acc -= C[i, u, q] * W[q, v]
+                W[u, v] = acc * r_uu
+        for u in range(dp):
+            for v in range(u + 1):
+                acc = 0.0
+                for q in range(di):
+                    acc += W[q, u] * W[q, v]
+                D[p, u, v] -= sign * acc
+            acc = 0.0
+            for q in range(di):
+                acc += H[q, u] * col[q]
+            y[p, u] -= acc
+    for u in range(di):
+        y[i, u] = col[u]  # now z_i
+    return True
+
+
+@njit(cache=True, inline="always")
+def _substitute_node(i, p, di, dp, nb, A, row0, body_a, C, H, y, col):  # type: ignore[no-untyped-def]
+    """x_i = z_i − D_i⁻¹ H_ip x_p into y[i] (y[p] holds x_p), with D_i's factor from
+    :func:`_eliminate_node`."""
+    _coupling(i, p, di, dp, nb, A, row0, body_a, H)
+    for u in range(di):
+        acc = 0.0
+        for v in range(dp):
+            acc += H[u, v] * y[p, v]
+        col[u] = acc
+    _chol_solve(C[i], di, 1.0 if i < nb else -1.0, col)
+    for u in range(di):
+        y[i, u] -= col[u]
 
 
 @njit(cache=True)
@@ -630,46 +679,25 @@ def tree_solve(
             continue
         di = dim[i]
         sign = 1.0 if i < nb else -1.0
-        if not _cholesky(D[i], di, sign, C[i]):
-            if not (n_singular and i < nb and parent[i] >= 0):
+        p = int(parent[i])
+        dp = dim[p] if p >= 0 else 0
+        # the common block sizes as constants, so that the compiler unrolls their loops
+        if di == 6 and dp == 5:
+            ok = _eliminate_node(i, p, 6, 5, sign, nb, A, row0, body_a, D, C, H, W, y, col)
+        elif di == 5 and dp == 6:
+            ok = _eliminate_node(i, p, 5, 6, sign, nb, A, row0, body_a, D, C, H, W, y, col)
+        else:
+            ok = _eliminate_node(i, p, di, dp, sign, nb, A, row0, body_a, D, C, H, W, y, col)
+        if not ok:
+            if not (n_singular and i < nb and p >= 0):
                 return np.nan, np.nan, 1
             # a singular body's D_i: eliminate it with its joint to the parent, one node
-            k = int(parent[i])
-            if not _eliminate_pair(i, k, int(parent[k]), nb, A, row0, body_a, dim, D, C, X, y):
+            if not _eliminate_pair(i, p, int(parent[p]), nb, A, row0, body_a, dim, D, C, X, y):
                 return np.nan, np.nan, 1
-            merged[k] = True
+            merged[p] = True
             stored[i] = True
-            stored[k] = True
-            up[i] = int(parent[k])
-            continue
-        p = int(parent[i])
-        # z_i = D_i⁻¹ y_i (y_i is final: every child has been subtracted)
-        for u in range(di):
-            col[u] = y[i, u]
-        _chol_solve(C[i], di, sign, col)
-        if p >= 0:
-            dp = _coupling(i, p, nb, A, row0, body_a, dim, H)
-            # D_p −= H_ipᵀ D_i⁻¹ H_ip = sign · Wᵀ W with W = L_i⁻¹ H_ip (D_i = sign · L_i L_iᵀ),
-            # its lower triangle (the Cholesky reads no other); y_p −= H_ipᵀ z_i
-            for u in range(di):  # row by row: the d_p columns are independent chains
-                r_uu = C[i, u, u]
-                for v in range(dp):
-                    acc = H[u, v]
-                    for q in range(u):
-                        acc -= C[i, u, q] * W[q, v]
-                    W[u, v] = acc * r_uu
-            for u in range(dp):
-                for v in range(u + 1):
-                    acc = 0.0
-                    for q in range(di):
-                        acc += W[q, u] * W[q, v]
-                    D[p, u, v] -= sign * acc
-                acc = 0.0
-                for q in range(di):
-                    acc += H[q, u] * col[q]
-                y[p, u] -= acc
-        for u in range(di):
-            y[i, u] = col[u]  # now z_i
+            stored[p] = True
+            up[i] = int(parent[p])
     # x_i = z_i − D_i⁻¹ H_ip x_p (X_i x_p where stored), roots first (y holds z, then x)
     for step in range(nn - 1, -1, -1):
         i = int(order[step])
@@ -685,15 +713,12 @@ def tree_solve(
                     acc += X[i, u, v] * y[p, v]
                 y[i, u] -= acc
             continue
-        _coupling(i, p, nb, A, row0, body_a, dim, H)
-        for u in range(di):
-            acc = 0.0
-            for v in range(dp):
-                acc += H[u, v] * y[p, v]
-            col[u] = acc
-        _chol_solve(C[i], di, 1.0 if i < nb else -1.0, col)
-        for u in range(di):
-            y[i, u] -= col[u]
+        if di == 6 and dp == 5:
+            _substitute_node(i, p, 6, 5, nb, A, row0, body_a, C, H, y, col)
+        elif di == 5 and dp == 6:
+            _substitute_node(i, p, 5, 6, nb, A, row0, body_a, C, H, y, col)
+        else:
+            _substitute_node(i, p, di, dp, nb, A, row0, body_a, C, H, y, col)
     for i in range(nb):
         for e in range(6):
             ac[6 * i + e] = y[i, e]
