@@ -27,6 +27,8 @@ from gmuk.view import (
     LINK_COLOUR,
     LINK_RADIUS_OF_ROBOT,
     LINK_RADIUS_OF_SCENE,
+    _capsules,
+    _typed,
     decimate,
     joint_frames,
     view_html,
@@ -113,17 +115,20 @@ def named(traces: list[dict], name: str) -> dict:
 
 
 def numbers(values: list | dict) -> np.ndarray:
-    """A trace's coordinates: a list, or plotly.js's typed-array form (base64 of doubles)."""
+    """A trace's coordinates: a list, or plotly.js's typed-array form (base64 of little-endian
+    doubles, f8, or singles, f4), as doubles."""
     if isinstance(values, dict):
-        assert values["dtype"] == "f8"
-        return np.frombuffer(base64.b64decode(values["bdata"]), dtype="<f8")
+        dtype = {"f8": "<f8", "f4": "<f4"}[values["dtype"]]
+        return np.frombuffer(base64.b64decode(values["bdata"]), dtype=dtype).astype(float)
     return np.array(values, dtype=float)
 
 
 def mesh(trace: dict, first: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The vertices (n, 3) and triangles (t, 3) of a mesh3d trace; an animation frame's trace
-    moves the vertices of ``first``, the page's trace, whose triangles it keeps."""
+    moves the vertices of ``first``, the page's trace, whose triangles it keeps. The capsules'
+    vertices are stored in single precision."""
     assert trace["type"] == "mesh3d"
+    assert all(trace[c]["dtype"] == "f4" for c in "xyz")
     vertices = np.stack([numbers(trace[c]) for c in "xyz"], axis=1)
     faces = first if first is not None else trace
     triangles = np.array([faces[c] for c in "ijk"]).T
@@ -151,11 +156,29 @@ def pieces(trace: dict) -> int:
     return int(connected_components(graph, directed=False)[0])
 
 
-def check_capsules(trace: dict, first: dict | None, links: np.ndarray, rho: float) -> None:
-    """``trace`` draws one closed capsule of radius rho about each segment of ``links``
-    (k, 2, 3), in order: each capsule's vertices at distance rho from its segment, its caps
-    reaching rho beyond the segment's ends along it, its triangles a closed surface."""
-    vertices, triangles = mesh(trace, first)
+#: Single precision's unit round-off: rounding x to the nearest float32 x̃ (24 significant bits,
+#: consecutive float32s 2⁻²³ |x̃| apart at most) moves it by |x̃ − x| ≤ 2⁻²⁴ |x̃|, half that
+#: spacing (x̃ normal: |x̃| > 1.2e-38). A vertex p stored as p̃ then moves by
+#: ‖p̃ − p‖ ≤ 2⁻²⁴ ‖p̃‖ (coordinate by coordinate), about 6e-8 m at 1 m from N's origin.
+SINGLE = 2.0**-24
+
+
+def stored_error(vertices: np.ndarray) -> np.ndarray:
+    """The bound 2⁻²⁴ ‖p̃‖ on how far each stored vertex p̃ (n, 3) is from the double-precision
+    vertex it rounds."""
+    return SINGLE * np.linalg.norm(vertices, axis=1)
+
+
+def check_mesh(
+    vertices: np.ndarray, triangles: np.ndarray, links: np.ndarray, rho: float, moved: np.ndarray
+) -> None:
+    """``vertices`` (n, 3) and ``triangles`` (t, 3) are one closed capsule of radius rho about
+    each segment of ``links`` (k, 2, 3), in order: each capsule's vertices at distance rho from
+    its segment, its caps reaching rho beyond the segment's ends along it, its triangles a
+    closed surface. The double-precision geometry is exact to round-off, 1e-12 rho; a vertex
+    that may have moved by up to ``moved`` (n,) from it, being stored in single precision, is
+    within that more: the distance to a segment and the offset along it change by no more than
+    the point moves."""
     assert np.isfinite(vertices).all()
     n_caps = len(links)
     assert n_caps > 0 and len(vertices) % n_caps == 0  # one capsule a segment, all alike
@@ -172,13 +195,23 @@ def check_capsules(trace: dict, first: dict | None, links: np.ndarray, rho: floa
     assert len({tuple(e) for e in edges}) == len(edges)
     assert {tuple(e) for e in edges} == {(b, a) for a, b in edges}
     for c, (a, b) in enumerate(links):
-        p = vertices[c * per : (c + 1) * per]
-        np.testing.assert_allclose(distance_to_segment(p, a, b), rho, rtol=1e-12, atol=0)
+        p, e = vertices[c * per : (c + 1) * per], moved[c * per : (c + 1) * per]
+        off = np.abs(distance_to_segment(p, a, b) - rho)
+        assert (off <= 1e-12 * rho + e).all(), (off / rho).max()
         length = np.linalg.norm(b - a)
         if length > 0:  # the caps: rho beyond each end, along the segment
             u = (b - a) / length
-            assert abs(((p - b) @ u).max() - rho) <= 1e-12 * rho
-            assert abs(((p - a) @ u).min() + rho) <= 1e-12 * rho
+            assert abs(((p - b) @ u).max() - rho) <= 1e-12 * rho + e.max()
+            assert abs(((p - a) @ u).min() + rho) <= 1e-12 * rho + e.max()
+
+
+def check_capsules(trace: dict, first: dict | None, links: np.ndarray, rho: float) -> None:
+    """``trace`` (the page's, or an animation frame's moving that of ``first``) draws one
+    closed capsule of radius rho about each segment of ``links`` (k, 2, 3), to single
+    precision: each stored vertex p̃ within 1e-12 rho + 2⁻²⁴ ‖p̃‖ (:data:`SINGLE`) of where
+    it should be."""
+    vertices, triangles = mesh(trace, first)
+    check_mesh(vertices, triangles, links, rho, stored_error(vertices))
 
 
 def expected_skeleton(system: gmuk.System, state: gmuk.State, length: float):
@@ -218,15 +251,37 @@ def test_the_links_are_capsules_about_the_joint_frames_at_every_frame(which, req
             np.testing.assert_allclose(
                 segments(named(drawn, f"joint axis {a + 1}")), axes[a], rtol=0, atol=1e-12
             )
+        # the mesh in double precision, before it is stored: exact to round-off
+        vertices, triangles = _capsules(links[:, 0], links[:, 1], rho, 0.0)
+        check_mesh(vertices, triangles, links, rho, np.zeros(len(vertices)))
+        assert np.array_equal(triangles, mesh(page_links)[1])
         if f == 0:  # the first frame is the page's initial data
             check_capsules(page_links, None, links, rho)
             assert named(drawn, "links") == {k: page_links[k] for k in named(drawn, "links")}
         assert "i" not in named(drawn, "links")  # the frames move the page's mesh
     if len(ground):  # the four-bar: O2 and O4; the Panda: its base (a sphere: at N's origin)
         check_capsules(named(data, "ground"), None, ground, rho)
+        # the page stores the nearest singles of the double-precision mesh, bit for bit
+        exact, _ = _capsules(ground[:, 0], ground[:, 1], rho, 0.0)
+        stored = named(data, "ground")
+        for n, c in enumerate("xyz"):
+            assert stored[c]["dtype"] == "f4"
+            assert base64.b64decode(stored[c]["bdata"]) == exact[:, n].astype("<f4").tobytes()
     # the links move: the middle frame's differ from the first's
     first, middle = (mesh(named(frames[k]["data"], "links"), page_links)[0] for k in (0, 3))
     assert np.abs(first - middle).max() > 0.05
+
+
+def test_single_precision_is_kept_for_numbers_it_holds():
+    """The capsules' typed arrays: the nearest singles of the doubles (f4), or the doubles
+    themselves (f8) for numbers beyond single precision's range (|x| > 3.4e38)."""
+    x = np.array([0.1, -2.0 / 3.0, 1e38, 0.0])
+    small = _typed(x, single=True)
+    assert small["dtype"] == "f4" and numbers(small).tolist() == x.astype(np.float32).tolist()
+    assert np.all(np.abs(numbers(small) - x) <= SINGLE * np.abs(numbers(small)))
+    huge = _typed(np.append(x, -1e39), single=True)
+    assert huge["dtype"] == "f8" and numbers(huge).tolist() == [*x, -1e39]
+    assert _typed(x)["dtype"] == "f8"
 
 
 def robot_reach(system: gmuk.System, state: gmuk.State) -> float:
@@ -283,7 +338,8 @@ def test_a_link_of_no_length_is_a_sphere(linkage):
     per = len(vertices) // 6
     sphere = vertices[2 * per : 3 * per]
     centre = odd.state(0).pose("coupler")[:3, 3]
-    np.testing.assert_allclose(np.linalg.norm(sphere - centre, axis=1), 0.03, rtol=1e-12)
+    off = np.abs(np.linalg.norm(sphere - centre, axis=1) - 0.03)  # in single precision
+    assert (off <= 1e-12 * 0.03 + stored_error(sphere)).all()
     assert np.isfinite(mesh(named(data, "ground"))[0]).all()
     for fr in frames:
         assert np.isfinite(mesh(named(fr["data"], "links"), named(data, "links"))[0]).all()
