@@ -10,6 +10,7 @@ accelerations must equal Pinocchio's ABA, which handles such links in reduced co
 
 from __future__ import annotations
 
+import mpmath
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -95,7 +96,6 @@ def test_icub_at_ill_conditioned_states_is_as_close_to_a_50_digit_solve_as_aba(b
     Pinocchio's M and nonlinear effects solved to 50 digits, gmuk's error stays below a
     hundredth of the worst case cond(M)·ε, as ABA's does (both measured up to 1.1e-3 of it
     over 30 states), and on the same order as ABA's own."""
-    mpmath = pytest.importorskip("mpmath")
     robot = Robot.from_urdf(example_robot_data("icub_description/robots/icub.urdf"), base=base)
     model, data = robot.model, robot.model.createData()
     rng = np.random.default_rng(11)
