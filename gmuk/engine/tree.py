@@ -225,7 +225,7 @@ def tree_params(
 
 
 @njit(cache=True, inline="always")
-def _singular_at(P: np.ndarray) -> int:
+def singular_at(P: np.ndarray) -> int:
     """Offset in P of the count of bodies with a singular mass block (their flags follow)."""
     nb = int(P[2])
     nc = int(P[3])
@@ -243,7 +243,7 @@ def body_rhs(V: np.ndarray, Q: np.ndarray, a: np.ndarray, P: np.ndarray, r: np.n
     o = _HEAD
     J = P[o : o + 9 * nb].reshape((nb, 3, 3))
     m = P[o + 18 * nb : o + 19 * nb]
-    f = _singular_at(P) + 1
+    f = singular_at(P) + 1
     for k in range(nb):
         o6 = 6 * k
         for e in range(6):
@@ -589,8 +589,8 @@ def tree_solve(
     a : ndarray (6 n_b,)
         ν̇_a, the free accelerations [ω̇; v̇] of the bodies (rad/s², m/s²).
     rhs : ndarray (6 n_b,)
-        The bodies' right-hand side (:func:`body_rhs`; N·m, N), read only for bodies with a
-        singular mass block (zero for the others by definition).
+        The bodies' right-hand side (:func:`body_rhs`; N·m, N), read only when some body has
+        a singular mass block (it may then be empty).
     A : ndarray (s, 12)
         Each constraint's rows on its first body (columns 0–5) and its second (6–11, zero
         for a constraint to the ground), stacked in constraint order.
@@ -650,7 +650,7 @@ def tree_solve(
             for v in range(3):
                 D[i, u, v] = J[i, u, v]
             D[i, 3 + u, 3 + u] = m[i]
-    n_singular = int(P[_singular_at(P)])
+    n_singular = int(P[singular_at(P)])
     if n_singular:  # the bodies' right-hand side r_i, zero where M_i is invertible
         for e in range(6 * nb):
             y[e // 6, e % 6] = rhs[e]
@@ -772,8 +772,9 @@ def tree_rigid(
     m = P[o + 18 * nb : o + 19 * nb]
     a = rigid_free_accel(V, J, Jinv, m, Q.reshape((nb, 6))).reshape(-1)
     ac = out[n : 2 * n]
-    rhs = np.empty(n)
-    body_rhs(V, Q, a, P, rhs)
+    rhs = np.zeros(n)
+    if P[singular_at(P)] != 0.0:  # bodies with a singular mass block
+        body_rhs(V, Q, a, P, rhs)
     residual, scale, status = tree_solve(a, rhs, A, b, P, ac, out[4 * n : 4 * n + s])
     for k in range(nb):
         for i in range(6):
@@ -972,6 +973,16 @@ def _constraint_pairs(system: System) -> tuple[list[tuple[int, int]], list[str]]
             continue
         pairs.append((idx[0], idx[1] if len(idx) == 2 else -1))
     return pairs, problems
+
+
+def _scale(A: FloatArray, b: FloatArray, a: FloatArray, ac: FloatArray) -> float:
+    """The consistency test's scale (:func:`consistency_scale`) of rows A, b and the free and
+    constraint accelerations a, ac."""
+    return float(
+        consistency_scale(
+            np.sqrt(b @ b), np.sqrt(np.sum(A * A)), np.linalg.norm(a), np.linalg.norm(ac)
+        )
+    )
 
 
 class TreeSolver(UKSolver):
@@ -1290,12 +1301,7 @@ class TreeSolver(UKSolver):
             A_sp, b - A_sp @ a, system._Minv_sp, system._Minv_sqrt_sp, system.sparse_solver
         )
         residual = float(np.linalg.norm(A_sp @ (a + ac) - b))
-        scale = float(
-            consistency_scale(
-                np.sqrt(b @ b), np.sqrt(np.sum(A * A)), np.linalg.norm(a), np.linalg.norm(ac)
-            )
-        )
-        self.check_consistency(state, residual, scale)
+        self.check_consistency(state, residual, _scale(A, b, a, ac))
         return ac, lam, rank_sp, residual, 0.0
 
     def _singular_kkt(
@@ -1321,10 +1327,5 @@ class TreeSolver(UKSolver):
         x = np.linalg.solve(K, rhs)
         ac, lam = x[:n], -x[n:]
         residual = float(np.linalg.norm(A @ (a + ac) - b))
-        scale = float(
-            consistency_scale(
-                np.sqrt(b @ b), np.sqrt(np.sum(A * A)), np.linalg.norm(a), np.linalg.norm(ac)
-            )
-        )
-        self.check_consistency(state, residual, scale)
+        self.check_consistency(state, residual, _scale(A, b, a, ac))
         return ac, lam, s, residual, 0.0

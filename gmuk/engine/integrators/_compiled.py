@@ -67,7 +67,15 @@ from gmuk.engine.integrators._program import (
     Program,
     reference_records,
 )
-from gmuk.engine.tree import TREE, body_rhs, constraint_block, kernel_rows, tree_pair, tree_solve
+from gmuk.engine.tree import (
+    TREE,
+    body_rhs,
+    constraint_block,
+    kernel_rows,
+    singular_at,
+    tree_pair,
+    tree_solve,
+)
 from gmuk.forces.base import FORCE_KERNEL
 from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
 
@@ -324,8 +332,9 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
                 P = parts.uk_params
                 rhs = np.zeros(0)
                 if d.solve == TREE:
-                    rhs = np.empty(ndof)  # zero but for bodies with a singular mass block
-                    body_rhs(V, modeled, total, P, rhs)
+                    if P[singular_at(P)] != 0.0:  # bodies with a singular mass block
+                        rhs = np.empty(ndof)
+                        body_rhs(V, modeled, total, P, rhs)
                     residual, scale, status = tree_solve(
                         total, rhs, A, b, P, ac, aux[4 * ndof : 4 * ndof + s]
                     )
