@@ -146,14 +146,19 @@ def breakdown(repeat: int) -> None:
         for _ in range(k):
             kernel(V, Q, A, b, P, out)
 
+    @njit
+    def tree_loop(kernel, g, V, Q, A, b, P, out, k):
+        for _ in range(k):
+            kernel(g, V, Q, A, b, P, out)
+
     print("one evaluation, piece by piece (medians; compiled pieces per call in a compiled loop)")
     for name, (path, base, locked) in ROBOTS.items():
-        _pieces(name, path, base, locked, repeat, rows_loop, solve_loop)
+        _pieces(name, path, base, locked, repeat, rows_loop, solve_loop, tree_loop)
 
 
-def _pieces(name, path, base, locked, repeat, rows_loop, solve_loop) -> None:
+def _pieces(name, path, base, locked, repeat, rows_loop, solve_loop, tree_loop) -> None:
     from gmuk.engine._uk_kernels import uk_rigid
-    from gmuk.engine.tree import tree_rigid
+    from gmuk.engine.tree import tree_params, tree_rigid
 
     robots = {
         s: Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked, solver=s)
@@ -179,9 +184,20 @@ def _pieces(name, path, base, locked, repeat, rows_loop, solve_loop) -> None:
     for a in args:
         rows_loop(*a, 1)
     t_rows = _median_s(lambda: [rows_loop(*a, 200) for a in args], repeat, 1) / 200
-    P = sys_t.solver._P
-    solve_loop(tree_rigid, V, modeled, A, b, P, out, 1)
-    t_tree = _median_s(lambda: solve_loop(tree_rigid, V, modeled, A, b, P, out, 200), repeat, 1)
+    solver = sys_t.solver
+    P = solver._P
+    g = np.array(state.g)
+    tree_loop(tree_rigid, g, V, modeled, A, b, P, out, 1)
+    t_tree = _median_s(lambda: tree_loop(tree_rigid, g, V, modeled, A, b, P, out, 200), repeat, 1)
+    # the same solve with every node eliminated as Baraff's (no joint eliminated with its child)
+    Pb = tree_params(
+        sys_t._J, sys_t._Jinv, sys_t._m_rigid, solver._order, solver._parent, solver._pairs,
+        solver._rows_n, sys_t.consistency_tol, sys_t._singular,
+    )  # fmt: skip
+    tree_loop(tree_rigid, g, V, modeled, A, b, Pb, out, 1)
+    t_baraff = _median_s(
+        lambda: tree_loop(tree_rigid, g, V, modeled, A, b, Pb, out, 200), repeat, 1
+    )
     sys_f = fused.system
     Af, bf = sys_f._stack_rows(fused.state(q, v), check_finite=False)
     Af = np.ascontiguousarray(Af)
@@ -193,7 +209,8 @@ def _pieces(name, path, base, locked, repeat, rows_loop, solve_loop) -> None:
     t_blocks = _median_s(lambda: sys_t.solver._blocks(state), repeat, 50)
     note = " (beyond its 48-row QR)" if bf.size > 48 else ""
     print(f"  {name:7s}: joint rows (all {len(args)} kernels) {t_rows * 1e6:6.1f} µs, "
-          f"tree solve {t_tree / 200 * 1e6:6.1f} µs, fused dense QR "
+          f"tree solve {t_tree / 200 * 1e6:6.1f} µs (nodes one by one, Baraff's: "
+          f"{t_baraff / 200 * 1e6:6.1f} µs), fused dense QR "
           f"{t_qr / 200 * 1e6:7.1f} µs{note}; in Python: loads {t_loads * 1e6:6.1f} µs, "
           f"rows {t_blocks * 1e6:6.1f} µs")  # fmt: skip
 

@@ -208,6 +208,12 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
         params, n_rows = packed
         return kernel, tuple(float(v) for v in params), int(n_rows)
 
+    def _tree_subspace(self) -> Any:
+        """For a constraint on the relative pose of two bodies whose rows on one of them are
+        constant (a joint), the :class:`gmuk.engine.tree.JointSubspace` that lets the tree
+        solve eliminate that body with it; None (the default) for any other."""
+        return None
+
     def _kernel_params(self) -> tuple[Any, int] | None:
         """The parameters of ``_kernel`` and the number of rows; None when the kernel cannot
         compute this constraint's rows."""

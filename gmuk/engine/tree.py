@@ -27,6 +27,16 @@ not certified to have full row rank, and the solve falls back to the dense
 (QR, else SVD) or the sparse strategy, which decide the rank and the minimum-norm solution.
 This is the maximal-coordinate counterpart of Featherstone's articulated-body algorithm.
 
+A joint (:class:`gmuk.robots.Joint`) whose child body is the tree's child of its node has
+constant rows G on that child and rows −G Ad_{g_c⁻¹ g_p} on its parent, whatever the poses:
+the body and the joint are then eliminated together (:func:`_articulated_step`), as the
+articulated-body algorithm does: with S (the joint's motions, G S = 0) and G⁺ (G G⁺ = I) in
+the child's frame, the parent receives Xᵀ I_a X, X = Ad_{g_c⁻¹ g_p}, with the articulated
+inertia I_a = D_c − D_c S (Sᵀ D_c S)⁻¹ Sᵀ D_c. That is the Schur complement the two node steps
+give (Gᵀ (G D_c⁻¹ Gᵀ)⁻¹ G = I_a), for one k × k Cholesky factor (k the joint's motions) in
+place of a 6 × 6 and a (6 − k) × (6 − k) one. A pivot of Sᵀ D_c S it cannot certify sends
+the pair back to the node steps.
+
 A body with a singular mass block (a link without mass, or a point mass:
 ``RigidBody(allow_singular=True)``) has no free acceleration of its own: its free acceleration
 takes M⁺, the loads M⁺ leaves go on its node's right-hand side (:func:`body_rhs`), and when
@@ -85,8 +95,10 @@ __all__ = [
     "PIVOT_TOL",
     "TREE",
     "TREE_SIGNATURE",
+    "JointSubspace",
     "TreeSolver",
     "body_rhs",
+    "subspaces_at",
     "tree_pair",
     "tree_params",
     "tree_rigid",
@@ -108,9 +120,10 @@ DENSE_FALLBACK_DOF = 300
 
 _RW1 = types.Array(types.float64, 1, "C")
 _RW2 = types.Array(types.float64, 2, "C")
+_RW3 = types.Array(types.float64, 3, "C")
 #: The signature of :func:`tree_rigid` (writable C-contiguous float64 arrays): the System's
 #: tree solve calls that overload's compiled function without numba's dispatcher.
-TREE_SIGNATURE = types.void(_RW2, _RW1, _RW2, _RW1, _RW1, _RW1)
+TREE_SIGNATURE = types.void(_RW3, _RW2, _RW1, _RW2, _RW1, _RW1, _RW1)
 _tree_rigid_c: Any = None
 
 _SOLVED = float(SolveStatus.SOLVED)
@@ -122,9 +135,22 @@ TREE = 4
 
 # Layout of the packed parameters P (float64): [unused, consistency_tol, n_b, n_c,
 # J (9 n_b), J⁻¹ (9 n_b), m (n_b), order (n_b + n_c), parent (n_b + n_c), body_a (n_c),
-# body_b (n_c), rows (n_c), n_singular, singular (n_b)]. Nodes 0 … n_b − 1 are the bodies,
-# n_b + k constraint k; J⁻¹ is J⁺ for a body with a singular mass block (``singular`` 1).
+# body_b (n_c), rows (n_c), n_singular, singular (n_b), joint subspaces (3 n_c: half, k_d,
+# offset), G⁺ and S of each joint with one]. Nodes 0 … n_b − 1 are the bodies, n_b + k
+# constraint k; J⁻¹ is J⁺ for a body with a singular mass block (``singular`` 1).
 _HEAD = 4
+
+
+class JointSubspace(NamedTuple):
+    """What the tree solve needs of a joint to eliminate its child with it
+    (:func:`_articulated_step`): the column half of its rows on the child (0 or 1), and in
+    the child's body frame G⁺ (6, s), a right inverse of the rows G on the child
+    (G G⁺ = I), and S (6, 6 − s) with G S = 0; the rows on the parent being −G Ad_{g_c⁻¹ g_p}
+    (a constraint on the relative pose of the two bodies only)."""
+
+    half: int
+    G_pinv: FloatArray
+    S: FloatArray
 
 
 # ----------------------------------------------------------------------------- structure
@@ -199,15 +225,19 @@ def tree_params(
     rows: list[int],
     consistency_tol: float,
     singular: np.ndarray | None = None,
+    subspaces: list[JointSubspace | None] | None = None,
 ) -> np.ndarray:
     """The constant arguments of :func:`tree_solve` and :func:`tree_rigid` in one writable
     float64 vector (see ``_HEAD``): the bodies' central inertias J (n_b, 3, 3) (kg·m²),
     their inverses (J⁺ where the mass block is singular), masses m (n_b,) (kg), the tree
-    (:func:`tree_structure`), each constraint's bodies and row count, and which bodies have
-    a singular mass block (``singular``, bool (n_b,); none by default)."""
+    (:func:`tree_structure`), each constraint's bodies and row count, which bodies have
+    a singular mass block (``singular``, bool (n_b,); none by default), and the joints
+    whose child the tree puts below them, with their constant G⁺ and S (``subspaces``, one
+    :class:`JointSubspace` or None per constraint: those take :func:`_articulated_step`;
+    none by default)."""
     nb, nc = m.shape[0], len(pairs)
     flags = np.zeros(nb) if singular is None else np.asarray(singular, dtype=float)
-    return np.concatenate(
+    head = np.concatenate(
         [
             [0.0, float(consistency_tol), float(nb), float(nc)],
             np.ravel(J),
@@ -221,7 +251,24 @@ def tree_params(
             [float(np.count_nonzero(flags))],
             flags,
         ]
-    ).astype(np.float64)
+    )
+    table = np.zeros(3 * nc)
+    table[0::3] = -1.0
+    constants: list[FloatArray] = []
+    at = head.size + 3 * nc
+    for k, sub in enumerate(subspaces or [None] * nc):
+        if sub is None:
+            continue
+        s_k, kd = sub.G_pinv.shape[1], sub.S.shape[1]
+        if s_k != rows[k] or s_k + kd != 6:
+            raise ValueError(f"constraint {k}: G⁺ (6, {s_k}) and S (6, {kd}) for {rows[k]} rows")
+        child = pairs[k][sub.half]
+        if parent[child] != nb + k:  # the tree puts the joint's child above it
+            continue
+        table[3 * k : 3 * k + 3] = (float(sub.half), float(kd), float(at))
+        constants += [sub.G_pinv.ravel(), sub.S.ravel()]
+        at += 6 * (s_k + kd)
+    return np.concatenate([head, table, *constants]).astype(np.float64)
 
 
 @njit(cache=True, inline="always")
@@ -230,6 +277,13 @@ def singular_at(P: np.ndarray) -> int:
     nb = int(P[2])
     nc = int(P[3])
     return _HEAD + 19 * nb + 2 * (nb + nc) + 3 * nc
+
+
+@njit(cache=True, inline="always")
+def subspaces_at(P: np.ndarray) -> int:
+    """Offset in P of the constraints' joint subspaces (three entries per constraint, see
+    :func:`tree_params`), after the singular flags."""
+    return singular_at(P) + 1 + int(P[2])
 
 
 @njit(cache=True)
@@ -572,8 +626,216 @@ def _substitute_node(i, p, di, dp, nb, A, row0, body_a, C, H, y, col):  # type: 
         y[i, u] -= col[u]
 
 
+@njit(cache=True, inline="always")
+def _joint_subspace(P, k):  # type: ignore[no-untyped-def]
+    """Constraint k's entry in the joint subspaces of P: (column half of its rows on its
+    child, number of motions k_d, offset of G⁺ (6 × s_k) then S (6 × k_d), row by row); the
+    half is −1 for a constraint without one (see :func:`tree_params`)."""
+    o = subspaces_at(P) + 3 * k
+    return int(P[o]), int(P[o + 1]), int(P[o + 2])
+
+
+@njit(cache=True, inline="always")
+def _relative_pose(g, c, p, out):  # type: ignore[no-untyped-def]
+    """g_c⁻¹ g_p as R = R_cᵀ R_p (out[0:3, 0:3]) and r = R_cᵀ (p_p − p_c) (out[3, 0:3])."""
+    for u in range(3):
+        for v in range(3):
+            out[u, v] = g[c, 0, u] * g[p, 0, v] + g[c, 1, u] * g[p, 1, v] + g[c, 2, u] * g[p, 2, v]
+    d0 = g[p, 0, 3] - g[c, 0, 3]
+    d1 = g[p, 1, 3] - g[c, 1, 3]
+    d2 = g[p, 2, 3] - g[c, 2, 3]
+    for u in range(3):
+        out[3, u] = g[c, 0, u] * d0 + g[c, 1, u] * d1 + g[c, 2, u] * d2
+
+
+@njit(cache=True, inline="always")
+def _ad_apply(T, x, out):  # type: ignore[no-untyped-def]
+    """out = Ad x for Ad = [[R, 0], [r̂R, R]] (R, r as :func:`_relative_pose` stores them)."""
+    for u in range(3):
+        out[u] = T[u, 0] * x[0] + T[u, 1] * x[1] + T[u, 2] * x[2]
+    for u in range(3):
+        out[3 + u] = T[u, 0] * x[3] + T[u, 1] * x[4] + T[u, 2] * x[5]
+    r0, r1, r2 = T[3, 0], T[3, 1], T[3, 2]
+    out[3] += r1 * out[2] - r2 * out[1]
+    out[4] += r2 * out[0] - r0 * out[2]
+    out[5] += r0 * out[1] - r1 * out[0]
+
+
+@njit(cache=True, inline="always")
+def _ad_transpose_add(T, f, out):  # type: ignore[no-untyped-def]
+    """out += Adᵀ f = [Rᵀ (f_τ + f_f × r); Rᵀ f_f] (a wrench from the child's frame to the
+    parent's; R, r as :func:`_relative_pose` stores them)."""
+    r0, r1, r2 = T[3, 0], T[3, 1], T[3, 2]
+    t0 = f[0] + (f[4] * r2 - f[5] * r1)
+    t1 = f[1] + (f[5] * r0 - f[3] * r2)
+    t2 = f[2] + (f[3] * r1 - f[4] * r0)
+    for u in range(3):
+        out[u] += T[0, u] * t0 + T[1, u] * t1 + T[2, u] * t2
+        out[3 + u] += T[0, u] * f[3] + T[1, u] * f[4] + T[2, u] * f[5]
+
+
+@njit(cache=True, inline="always")
+def _articulated_step(i, kk, p, s, kd, off, P, g, D, C, X, y, Ia, W, ws):  # type: ignore[no-untyped-def]
+    """Eliminate body i together with its joint (constraint node kk, s rows, k_d motions)
+    to its parent body p (−1: the ground), as the articulated-body algorithm does, in
+    maximal coordinates.
+
+    The joint's rows on the child are G (s × 6) with G G⁺ = I and G S = 0 for the constant
+    G⁺ (6 × s) and S (6 × k_d) in P, and its rows on the parent are −G X for the relative
+    transform X = Ad_{g_c⁻¹ g_p} (the joint constrains the relative pose only). Then the
+    pair's equations ``D_i x_i + Gᵀ μ = y_i``, ``G (x_i − X x_p) = y_k`` give
+    ``x_i = X x_p + c + S α`` with c = G⁺ y_k, α from Sᵀ of the first, and pass to the
+    parent ``D_p += Xᵀ I_a X`` and ``y_p += Xᵀ (y_i − U N⁻¹ Sᵀ y_i − I_a c)`` with
+    U = D_i S, N = Sᵀ U = L Lᵀ and the articulated inertia I_a = D_i − U N⁻¹ Uᵀ: the same
+    Schur complement as eliminating the body node and then the constraint node
+    (Gᵀ (G D_i⁻¹ Gᵀ)⁻¹ G = I_a), with one k_d × k_d factor instead of a 6 × 6 and an s × s.
+    Keeps D_i (full) in C[i], U in X[i], L in C[kk], R and r in X[kk]. False, with D[kk]
+    left zero, when N's Cholesky pivot is not certified."""
+    sp = off + 6 * s
+    Dc = C[i]
+    for u in range(6):
+        for v in range(u + 1):
+            Dc[u, v] = D[i, u, v]
+            Dc[v, u] = D[i, u, v]
+    U = X[i]
+    for u in range(6):
+        for j in range(kd):
+            acc = 0.0
+            for v in range(6):
+                acc += Dc[u, v] * P[sp + v * kd + j]
+            U[u, j] = acc
+    N = D[kk]
+    for j in range(kd):
+        for q in range(j + 1):
+            acc = 0.0
+            for v in range(6):
+                acc += P[sp + v * kd + j] * U[v, q]
+            N[j, q] = acc
+    L = C[kk]
+    if not _cholesky(N, kd, 1.0, L):
+        for j in range(kd):
+            for q in range(kd):
+                N[j, q] = 0.0
+        return False
+    if p < 0:  # a joint to the ground: nothing to pass on
+        return True
+    for u in range(6):  # W = L⁻¹ Uᵀ, column by column (each a chain of k_d)
+        for j in range(kd):
+            acc = U[u, j]
+            for q in range(j):
+                acc -= L[j, q] * W[q, u]
+            W[j, u] = acc * L[j, j]
+    for u in range(6):  # I_a = D_i − Wᵀ W
+        for v in range(u + 1):
+            acc = Dc[u, v]
+            for j in range(kd):
+                acc -= W[j, u] * W[j, v]
+            Ia[u, v] = acc
+            Ia[v, u] = acc
+    T = X[kk]
+    _relative_pose(g, i, p, T)
+    c = ws[0]
+    for u in range(6):  # c = G⁺ y_k
+        acc = 0.0
+        for q in range(s):
+            acc += P[off + u * s + q] * y[kk, q]
+        c[u] = acc
+    t = ws[1]
+    for j in range(kd):  # N⁻¹ Sᵀ y_i
+        acc = 0.0
+        for v in range(6):
+            acc += P[sp + v * kd + j] * y[i, v]
+        t[j] = acc
+    _chol_solve(L, kd, 1.0, t)
+    f = ws[2]
+    for u in range(6):  # f = y_i − U N⁻¹ Sᵀ y_i − I_a c
+        acc = y[i, u]
+        for j in range(kd):
+            acc -= U[u, j] * t[j]
+        for v in range(6):
+            acc -= Ia[u, v] * c[v]
+        f[u] = acc
+    _ad_transpose_add(T, f, y[p])
+    # D_p += Xᵀ I_a X, X = [[R, 0], [r̂R, R]]: Y = I_a X, then the lower triangle of Xᵀ Y
+    PR = ws[3]  # r̂R, column j at PR[3j : 3j + 3]
+    r0, r1, r2 = T[3, 0], T[3, 1], T[3, 2]
+    for j in range(3):
+        PR[j] = r1 * T[2, j] - r2 * T[1, j]
+        PR[3 + j] = r2 * T[0, j] - r0 * T[2, j]
+    Y = W  # W is spent: reuse it for Y (6 × 6)
+    for u in range(6):
+        for j in range(3):
+            Y[u, j] = (
+                Ia[u, 0] * T[0, j] + Ia[u, 1] * T[1, j] + Ia[u, 2] * T[2, j]
+                + Ia[u, 3] * (r1 * T[2, j] - r2 * T[1, j])
+                + Ia[u, 4] * (r2 * T[0, j] - r0 * T[2, j])
+                + Ia[u, 5] * (r0 * T[1, j] - r1 * T[0, j])
+            )  # fmt: skip
+            Y[u, 3 + j] = Ia[u, 3] * T[0, j] + Ia[u, 4] * T[1, j] + Ia[u, 5] * T[2, j]
+    for u in range(6):
+        for v in range(u + 1):
+            if u < 3:
+                acc = (
+                    T[0, u] * Y[0, v] + T[1, u] * Y[1, v] + T[2, u] * Y[2, v]
+                    + (r1 * T[2, u] - r2 * T[1, u]) * Y[3, v]
+                    + (r2 * T[0, u] - r0 * T[2, u]) * Y[4, v]
+                    + (r0 * T[1, u] - r1 * T[0, u]) * Y[5, v]
+                )  # fmt: skip
+            else:
+                acc = T[0, u - 3] * Y[3, v] + T[1, u - 3] * Y[4, v] + T[2, u - 3] * Y[5, v]
+            D[p, u, v] += acc
+    return True
+
+
+@njit(cache=True, inline="always")
+def _articulated_back(i, kk, p, s, kd, off, P, C, X, y, ws):  # type: ignore[no-untyped-def]
+    """The back-substitution of :func:`_articulated_step`: x_i = X x_p + c + S α with
+    α = N⁻¹ (Sᵀ y_i − Uᵀ (X x_p + c)), then μ = G⁺ᵀ (y_i − D_i x_i) (G⁺ᵀ Gᵀ = I), into y[i]
+    and y[kk] (y[p] holds x_p)."""
+    sp = off + 6 * s
+    v6 = ws[0]
+    if p >= 0:
+        _ad_apply(X[kk], y[p], v6)
+    else:
+        for u in range(6):
+            v6[u] = 0.0
+    for u in range(6):  # + c = G⁺ y_k
+        acc = 0.0
+        for q in range(s):
+            acc += P[off + u * s + q] * y[kk, q]
+        v6[u] += acc
+    U = X[i]
+    t = ws[1]
+    for j in range(kd):
+        acc = 0.0
+        for v in range(6):
+            acc += P[sp + v * kd + j] * y[i, v] - U[v, j] * v6[v]
+        t[j] = acc
+    _chol_solve(C[kk], kd, 1.0, t)
+    for u in range(6):
+        acc = v6[u]
+        for j in range(kd):
+            acc += P[sp + u * kd + j] * t[j]
+        v6[u] = acc
+    Dc = C[i]
+    f = ws[2]
+    for u in range(6):  # y_i − D_i x_i
+        acc = y[i, u]
+        for v in range(6):
+            acc -= Dc[u, v] * v6[v]
+        f[u] = acc
+    for q in range(s):
+        acc = 0.0
+        for u in range(6):
+            acc += P[off + u * s + q] * f[u]
+        y[kk, q] = acc
+    for u in range(6):
+        y[i, u] = v6[u]
+
+
 @njit(cache=True)
 def tree_solve(
+    g: np.ndarray,
     a: np.ndarray,
     rhs: np.ndarray,
     A: np.ndarray,
@@ -586,6 +848,8 @@ def tree_solve(
 
     Parameters
     ----------
+    g : ndarray (n_b, 4, 4)
+        The bodies' poses (read for the joints that :func:`_articulated_step` eliminates).
     a : ndarray (6 n_b,)
         ν̇_a, the free accelerations [ω̇; v̇] of the bodies (rad/s², m/s²).
     rhs : ndarray (6 n_b,)
@@ -656,6 +920,7 @@ def tree_solve(
             y[e // 6, e % 6] = rhs[e]
     up = np.empty(nn, dtype=np.int64)  # the parent in the back-substitution
     merged = np.zeros(nn, dtype=np.bool_)  # a constraint node eliminated with its child
+    articulated = np.zeros(nn, dtype=np.bool_)  # a body eliminated with its joint
     stored = np.zeros(nn, dtype=np.bool_)  # X_i = D_i⁻¹ H_ip kept (eliminated pairs)
     for i in range(nn):
         up[i] = int(parent[i])
@@ -673,10 +938,26 @@ def tree_solve(
     H = np.empty((6, 6))  # H_ip (d_i × d_p)
     W = np.empty((6, 6))  # L_i⁻¹ H_ip
     col = np.empty(6)
+    ws = np.empty((4, 6))
     for step in range(nn):
         i = int(order[step])
         if merged[i]:
             continue
+        if i < nb and int(parent[i]) >= nb:  # a body below a joint it can be eliminated with
+            kk = int(parent[i])
+            half, kd, off = _joint_subspace(P, kk - nb)
+            if half >= 0:
+                p = int(parent[kk])
+                sk = dim[kk]
+                if sk == 5:  # one motion (revolute, prismatic, screw) as constants: unrolled
+                    ok = _articulated_step(i, kk, p, 5, 1, off, P, g, D, C, X, y, H, W, ws)
+                else:
+                    ok = _articulated_step(i, kk, p, sk, kd, off, P, g, D, C, X, y, H, W, ws)
+                if ok:
+                    merged[kk] = True
+                    articulated[i] = True
+                    up[i] = p
+                    continue
         di = dim[i]
         sign = 1.0 if i < nb else -1.0
         p = int(parent[i])
@@ -702,7 +983,15 @@ def tree_solve(
     for step in range(nn - 1, -1, -1):
         i = int(order[step])
         p = up[i]
-        if p < 0:
+        if articulated[i]:
+            kk = int(parent[i])
+            _half, kd, off = _joint_subspace(P, kk - nb)
+            if dim[kk] == 5:
+                _articulated_back(i, kk, p, 5, 1, off, P, C, X, y, ws)
+            else:
+                _articulated_back(i, kk, p, dim[kk], kd, off, P, C, X, y, ws)
+            continue
+        if p < 0 or (merged[i] and not stored[i]):
             continue
         di = dim[i]
         dp = dim[p]
@@ -754,9 +1043,16 @@ def tree_solve(
 
 @njit(cache=True)
 def tree_rigid(
-    V: np.ndarray, Q: np.ndarray, A: np.ndarray, b: np.ndarray, P: np.ndarray, out: np.ndarray
+    g: np.ndarray,
+    V: np.ndarray,
+    Q: np.ndarray,
+    A: np.ndarray,
+    b: np.ndarray,
+    P: np.ndarray,
+    out: np.ndarray,
 ) -> None:
-    """Free accelerations (Eq. 10b) of the twists V (n_b, 6) under the modeled wrenches Q
+    """Free accelerations (Eq. 10b) of the bodies at poses g (n_b, 4, 4) with twists
+    V (n_b, 6) under the modeled wrenches Q
     (6 n_b,), :func:`tree_solve` of the rows A (s, 12), b (s,), the constraint wrenches
     Aᵀλ (M ν̇_c, less :func:`body_rhs` for a body with a singular mass block) and the
     total, into ``out`` (4n + s + 3, n = 6 n_b): ``[a, ν̇_c, total, M ν̇_c, λ,
@@ -775,7 +1071,7 @@ def tree_rigid(
     rhs = np.zeros(n)
     if P[singular_at(P)] != 0.0:  # bodies with a singular mass block
         body_rhs(V, Q, a, P, rhs)
-    residual, scale, status = tree_solve(a, rhs, A, b, P, ac, out[4 * n : 4 * n + s])
+    residual, scale, status = tree_solve(g, a, rhs, A, b, P, ac, out[4 * n : 4 * n + s])
     for k in range(nb):
         for i in range(6):
             r = 6 * k + i
@@ -852,7 +1148,7 @@ def tree_rows_rigid(
         status = constraint_block(t, g, V, cons, cparams, c, A, b)
         if status != 0:
             return status
-    tree_rigid(V, Q, A, b, P, out)
+    tree_rigid(g, V, Q, A, b, P, out)
     return 0
 
 
@@ -898,7 +1194,6 @@ def tree_loads_rows_rigid(t, g, V, terms, params, fdata, cons, cparams, P, A, b,
     return tree_rows_rigid(t, g, V, Q, cons, cparams, P, A, b, out)
 
 
-_RW3 = types.Array(types.float64, 3, "C")
 _I2 = types.Array(types.int64, 2, "C")
 _RO1 = types.Array(types.float64, 1, "C", readonly=True)
 #: The signature of :func:`tree_rows_rigid` as the System calls it.
@@ -1024,6 +1319,8 @@ class TreeSolver(UKSolver):
         self._zero_z = system._zero_z
         self._constraints = system.constraints
         self._rows_n: list[int] | None = None
+        # the joints the solve eliminates with their child, as the articulated-body algorithm
+        self._subspaces = [c._tree_subspace() for c in system.constraints]
         self._P = np.zeros(1)
         self._last_rhs = np.zeros(system.layout.n_dof)
         terms = [c._compiled_term() for c in system.constraints]
@@ -1065,7 +1362,7 @@ class TreeSolver(UKSolver):
         self._rows_n = rows
         self._P = tree_params(
             s._J, s._Jinv, s._m_rigid, self._order, self._parent, self._pairs, rows,
-            s.consistency_tol, s._singular,
+            s.consistency_tol, s._singular, self._subspaces,
         )  # fmt: skip
 
     def loop_constants(self, state: State) -> np.ndarray:
@@ -1199,10 +1496,11 @@ class TreeSolver(UKSolver):
             A, b = self._blocks(state)
             s = b.size
             out = np.empty(4 * n + s + 3)
+            g = np.array(state.g, dtype=float)  # a writable copy: the kernel's type
             if V.dtype == _F64 and V.shape == self._V_shape and V.flags.c_contiguous:
-                _tree_rigid_c(_writable(V), _writable(modeled), A, b, self._P, out)
+                _tree_rigid_c(g, _writable(V), _writable(modeled), A, b, self._P, out)
             else:
-                tree_rigid(np.ascontiguousarray(V, dtype=float), modeled, A, b, self._P, out)
+                tree_rigid(g, np.ascontiguousarray(V, dtype=float), modeled, A, b, self._P, out)
             status = float(out[-1])
         if status == _SOLVED:
             return self._solved(out, s, unmodeled)
@@ -1248,7 +1546,9 @@ class TreeSolver(UKSolver):
             return np.zeros_like(a), np.zeros(0), 0, 0.0, 0.0
         ac = np.zeros(self._n)
         lam = np.zeros(b.size)
-        residual, scale, status = tree_solve(a, r, A, b, self._P, ac, lam)
+        residual, scale, status = tree_solve(
+            np.ascontiguousarray(state.g, dtype=float), a, r, A, b, self._P, ac, lam
+        )
         if status == 0 and residual <= self.system.consistency_tol * scale:
             return ac, lam, b.size, float(residual), 0.0
         if status == 2 or not (all_finite(A) and all_finite(b)):

@@ -492,6 +492,23 @@ class Joint(Constraint):
         joint_residuals(*self._pair(state), self._params, pos, vel)
         return pos, vel
 
+    def _tree_subspace(self) -> Any:
+        """The rows on the child, ``T Ad_{X_CJ⁻¹}``, are constant (but for the universal
+        joint's last row), with G⁺ = Ad_{X_CJ} Tᵀ (T Tᵀ = I) and S_C = Ad_{X_CJ} S in the
+        child's frame; the rows on the parent are ``−T Ad_{h⁻¹} Ad_{X_PJ⁻¹} = −G Ad_{g_C⁻¹ g_P}``.
+        Only for the compiled kernel's rows (a subclass with its own ``rows`` has none)."""
+        from gmuk.engine.tree import JointSubspace
+
+        term = self._compiled_term()
+        if term is None or term[0] is not joint_rows or self._residual_kind == _UNIVERSAL:
+            return None
+        Ad_CJ = se3._Ad(self.child_frame)
+        return JointSubspace(
+            0 if self.grounded else 1,
+            np.ascontiguousarray(Ad_CJ @ self._T.T),
+            np.ascontiguousarray(Ad_CJ @ self.motion_subspace),
+        )
+
     # -- reading the joint
     def relative_pose(self, state: State) -> FloatArray:
         """h = g_{J_p}⁻¹ g_{J_c} (4, 4): J_c in J_p (m)."""

@@ -15,7 +15,14 @@ import pytest
 
 import gmuk
 from gmuk.constraints.base import Constraint
-from gmuk.engine.tree import TREE, TreeSolver, tree_structure
+from gmuk.engine.tree import (
+    TREE,
+    TreeSolver,
+    subspaces_at,
+    tree_params,
+    tree_solve,
+    tree_structure,
+)
 from gmuk.errors import DefinitionError
 from gmuk.lie import se3
 from gmuk.robots import (
@@ -384,3 +391,85 @@ def test_stabilised_joints_and_unmodeled_loads_equal_dense():
     b = dense.simulate(_same_state(dense, state), (0.0, 0.05), t_eval=[0.0, 0.05])
     assert calls[0] <= 2
     assert np.abs(np.asarray(a.V_B) - np.asarray(b.V_B)).max() <= 1e-8
+
+
+# ------------------------------------------------------ joints eliminated with their child
+def _articulated(system: gmuk.System) -> list[bool]:
+    """Which constraints the tree solve eliminates with their child body
+    (:func:`gmuk.engine.tree._articulated_step`)."""
+    P = system.solver._P
+    at = subspaces_at(P)
+    return [P[at + 3 * k] >= 0.0 for k in range(int(P[3]))]
+
+
+def _node_by_node(system: gmuk.System) -> np.ndarray:
+    """The packed tree of ``system`` with no joint subspace: every node eliminated alone."""
+    solver = system.solver
+    return tree_params(
+        system._J, system._Jinv, system._m_rigid, solver._order, solver._parent, solver._pairs,
+        solver._rows_n, system.consistency_tol, system._singular,
+    )  # fmt: skip
+
+
+def _both_solves(system: gmuk.System, state: gmuk.State) -> tuple[tuple, tuple]:
+    """(ν̇_c, λ, status) of the tree solve with the joints' subspaces and without."""
+    solver = system.solver
+    A, b = solver._blocks(state)
+    g = np.ascontiguousarray(state.g, dtype=float)
+    a = np.random.default_rng(0).normal(size=system.layout.n_dof)
+    out = []
+    for P in (solver._P, _node_by_node(system)):
+        ac, lam = np.zeros(a.size), np.zeros(b.size)
+        _residual, _scale, status = tree_solve(g, a, np.zeros(a.size), A, b, P, ac, lam)
+        out.append((ac, lam, status))
+    return out[0], out[1]
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_robot_joints_are_eliminated_with_their_child(name):
+    """Every joint of the URDF robots takes the articulated step, whose answer is the
+    node-by-node elimination's to round-off (the same Schur complement)."""
+    robot = _robot(name, solver="tree")
+    assert all(_articulated(robot.system))
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        q, v = _random_qv(robot.model, rng)
+        (ac, lam, status), (ac0, lam0, status0) = _both_solves(robot.system, robot.state(q, v))
+        assert status == status0 == 0
+        assert _relative(ac, ac0) <= RTOL and _relative(lam, lam0) <= RTOL
+
+
+def test_every_joint_kind_but_the_universal_is_eliminated_with_its_child():
+    """The universal joint's constrained rotation moves with it (its rows on the child are
+    not constant): node by node. Violated joints (random poses) change nothing: the rows on
+    the parent are −G Ad_{g_c⁻¹ g_p} at any poses."""
+    system = _branched(solver="tree")
+    kinds = [type(c).__name__ for c in system.constraints]
+    assert [k for k, yes in zip(kinds, _articulated(system), strict=True) if not yes] == [
+        "UniversalJoint"
+    ]
+    for seed in range(3):
+        (ac, lam, status), (ac0, lam0, status0) = _both_solves(system, _random_state(system, seed))
+        assert status == status0 == 0
+        assert _relative(ac, ac0) <= RTOL and _relative(lam, lam0) <= RTOL
+
+
+def test_a_joint_whose_child_is_nearer_the_root_is_eliminated_node_by_node():
+    """A floating pair listed child first: the tree is rooted at the joint's child, so the
+    joint's constant rows are on the body above it, and the solve takes Baraff's steps."""
+    links = _links(2)
+    X, Xi = _half(0.2), np.linalg.inv(_half(0.2))
+    joint = RevoluteJoint(links[1], links[0], parent_frame=X, child_frame=Xi)
+    tree = gmuk.System(links, [joint], solver="tree")
+    dense = gmuk.System(links, [joint], solver="dense")
+    assert _articulated(tree) == [False]
+    state = _random_state(tree, 2)
+    _assert_same(tree.accelerations(state), dense.accelerations(_same_state(dense, state)))
+
+
+def test_a_joint_with_rows_from_python_is_eliminated_node_by_node():
+    """A subclass with its own ``rows`` promises nothing about them."""
+    system = _python_rows_chain(4)
+    system.accelerations(_random_state(system, 4))  # packs the row counts from Python
+    assert _articulated(system) == [True, False, True, False]
+    assert _PythonRevolute(None, "x")._tree_subspace() is None

@@ -336,7 +336,7 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
                         rhs = np.empty(ndof)
                         body_rhs(V, modeled, total, P, rhs)
                     residual, scale, status = tree_solve(
-                        total, rhs, A, b, P, ac, aux[4 * ndof : 4 * ndof + s]
+                        g, total, rhs, A, b, P, ac, aux[4 * ndof : 4 * ndof + s]
                     )
                 else:
                     Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
