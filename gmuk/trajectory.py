@@ -11,6 +11,7 @@ computed).
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -159,9 +160,9 @@ class Trajectory:
     stats: dict[str, Any] = field(default_factory=dict)
     events: tuple[EventRecord, ...] = ()
 
-    @property
+    @functools.cached_property
     def layout(self) -> Layout:
-        """The body index of this trajectory."""
+        """The body index of this trajectory (built once: every :meth:`state` shares it)."""
         kinds = tuple(BodyKind(k) for k in self.body_kinds)
         return Layout(self.body_names, kinds, self.body_dofs, self.z.shape[1])
 

@@ -833,6 +833,19 @@ def _articulated_back(i, kk, p, s, kd, off, P, C, X, y, ws):  # type: ignore[no-
         y[i, u] = v6[u]
 
 
+@njit(cache=True, inline="always")
+def _failed(A: np.ndarray, b: np.ndarray) -> int:
+    """The status of a solve that stops early: 2 when A or b has an entry that is not
+    finite (checked only then: a finite residual and norms certify them), else 1."""
+    for i in range(b.shape[0]):
+        if not np.isfinite(b[i]):
+            return 2
+        for e in range(12):
+            if not np.isfinite(A[i, e]):
+                return 2
+    return 1
+
+
 @njit(cache=True)
 def tree_solve(
     g: np.ndarray,
@@ -873,12 +886,6 @@ def tree_solve(
     nc = int(P[3])
     nn = nb + nc
     s = b.shape[0]
-    for i in range(s):
-        if not np.isfinite(b[i]):
-            return np.nan, np.nan, 2
-        for e in range(12):
-            if not np.isfinite(A[i, e]):
-                return np.nan, np.nan, 2
     o = _HEAD
     J = P[o : o + 9 * nb].reshape((nb, 3, 3))
     o += 18 * nb  # J, J⁻¹
@@ -891,23 +898,27 @@ def tree_solve(
     body_a = P[o : o + nc]
     body_b = P[o + nc : o + 2 * nc]
     nrow = P[o + 2 * nc : o + 3 * nc]
-    row0 = np.empty(nc, dtype=np.int64)
-    dim = np.empty(nn, dtype=np.int64)
+    index = np.empty((3, nn), dtype=np.int64)
+    row0 = index[0, :nc]
+    dim = index[1]
+    up = index[2]  # the parent in the back-substitution
     r = 0
     for k in range(nc):
         row0[k] = r
         dk = int(nrow[k])
         if dk > 6:
-            return np.nan, np.nan, 1
+            return np.nan, np.nan, _failed(A, b)
         dim[nb + k] = dk
         r += dk
     if r != s:
-        return np.nan, np.nan, 1
+        return np.nan, np.nan, _failed(A, b)
     for i in range(nb):
         dim[i] = 6
-    D = np.zeros((nn, 6, 6))
-    C = np.empty((nn, 6, 6))
-    X = np.empty((nn, 6, 6))
+    blocks = np.empty((3, nn, 6, 6))
+    D = blocks[0]
+    C = blocks[1]
+    X = blocks[2]
+    D[:] = 0.0
     y = np.zeros((nn, 6))
     for i in range(nb):  # D_i = M_i = blkdiag(J_i, m_i I)
         for u in range(3):
@@ -918,10 +929,10 @@ def tree_solve(
     if n_singular:  # the bodies' right-hand side r_i, zero where M_i is invertible
         for e in range(6 * nb):
             y[e // 6, e % 6] = rhs[e]
-    up = np.empty(nn, dtype=np.int64)  # the parent in the back-substitution
-    merged = np.zeros(nn, dtype=np.bool_)  # a constraint node eliminated with its child
-    articulated = np.zeros(nn, dtype=np.bool_)  # a body eliminated with its joint
-    stored = np.zeros(nn, dtype=np.bool_)  # X_i = D_i⁻¹ H_ip kept (eliminated pairs)
+    flags = np.zeros((3, nn), dtype=np.bool_)
+    merged = flags[0]  # a constraint node eliminated with its child
+    articulated = flags[1]  # a body eliminated with its joint
+    stored = flags[2]  # X_i = D_i⁻¹ H_ip kept (eliminated pairs)
     for i in range(nn):
         up[i] = int(parent[i])
     for k in range(nc):  # the joint nodes' right-hand side r_k = b_k − A_k a
@@ -935,10 +946,11 @@ def tree_solve(
                 if ib >= 0:
                     acc -= A[row, 6 + e] * a[6 * ib + e]
             y[nb + k, u] = acc
-    H = np.empty((6, 6))  # H_ip (d_i × d_p)
-    W = np.empty((6, 6))  # L_i⁻¹ H_ip
-    col = np.empty(6)
-    ws = np.empty((4, 6))
+    scratch = np.empty((17, 6))
+    H = scratch[0:6]  # H_ip (d_i × d_p)
+    W = scratch[6:12]  # L_i⁻¹ H_ip
+    col = scratch[12]
+    ws = scratch[13:17]
     for step in range(nn):
         i = int(order[step])
         if merged[i]:
@@ -971,10 +983,10 @@ def tree_solve(
             ok = _eliminate_node(i, p, di, dp, sign, nb, A, row0, body_a, D, C, H, W, y, col)
         if not ok:
             if not (n_singular and i < nb and p >= 0):
-                return np.nan, np.nan, 1
+                return np.nan, np.nan, _failed(A, b)
             # a singular body's D_i: eliminate it with its joint to the parent, one node
             if not _eliminate_pair(i, p, int(parent[p]), nb, A, row0, body_a, dim, D, C, X, y):
-                return np.nan, np.nan, 1
+                return np.nan, np.nan, _failed(A, b)
             merged[p] = True
             stored[i] = True
             stored[p] = True
@@ -1037,6 +1049,8 @@ def tree_solve(
     for e in range(6 * nb):
         na += a[e] * a[e]
         nac += ac[e] * ac[e]
+    if not (np.isfinite(nA) and np.isfinite(nbb)) and _failed(A, b) == 2:
+        return np.nan, np.nan, 2
     scale = consistency_scale(np.sqrt(nbb), np.sqrt(nA), np.sqrt(na), np.sqrt(nac))
     return np.sqrt(rr), scale, 0
 
@@ -1106,19 +1120,16 @@ def kernel_rows(t, g, V, cons, cparams, c, Ak, bk):  # type: ignore[no-untyped-d
 @njit(cache=True)
 def constraint_block(t, g, V, cons, cparams, c, A, b):  # type: ignore[no-untyped-def]
     """Constraint ``c``'s rows by :func:`kernel_rows` into its block of the tree's A (s, 12)
-    and b (s,), from row ``cons[c, 3]`` (columns 6–11 only for a constraint on two bodies).
-    Returns the kernel's status."""
+    and b (s,), from row ``cons[c, 3]`` (the kernel writes into the block itself; columns
+    6–11 are zeroed after it for a constraint on one body). Returns the kernel's status."""
     r0, nrow = cons[c, 3], cons[c, 4]
-    Ak = np.empty((nrow, 12))
-    bk = np.empty(nrow)
-    status = kernel_rows(t, g, V, cons, cparams, c, Ak, bk)
+    status = kernel_rows(t, g, V, cons, cparams, c, A[r0 : r0 + nrow], b[r0 : r0 + nrow])
     if status != 0:
         return status
-    width = 12 if cons[c, 2] >= 0 else 6
-    for a in range(nrow):
-        b[r0 + a] = bk[a]
-        for e in range(width):
-            A[r0 + a, e] = Ak[a, e]
+    if cons[c, 2] < 0:  # one body: what the kernel wrote for a second is not a row
+        for a in range(nrow):
+            for e in range(6, 12):
+                A[r0 + a, e] = 0.0
     return 0
 
 

@@ -63,7 +63,8 @@ __all__ = [
 # kinds of residual (the parameters' second entry)
 _CONSTANT, _UNIVERSAL, _SCREW = 0, 1, 2
 # layout of the packed parameters: [grounded, kind, s, X_PJ (16), X_CJ (16),
-# Ad_{X_PJ⁻¹} (36), Ad_{X_CJ⁻¹} (36), T (s × 6), α (s), β (s), extra (6)]
+# Ad_{X_PJ⁻¹} (36), Ad_{X_CJ⁻¹} (36), T (s × 6), α (s), β (s), extra (6), G (s × 6)]:
+# G = T Ad_{X_CJ⁻¹}, the rows on the child, constant but for a universal joint's last row
 _HEAD = 3 + 16 + 16 + 36 + 36
 
 
@@ -231,6 +232,23 @@ def _position_residual(p, s, a1, i, xi):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
+def _child_rows(p):  # type: ignore[no-untyped-def]
+    """G = T Ad_{X_CJ⁻¹} (s × 6), the rows on the child, into the end of the parameters p
+    (the universal joint's last row, which moves, is left zero and computed at each call)."""
+    s = int(p[2])
+    G = _HEAD + 8 * s + 6
+    for i in range(s):
+        T = (
+            p[_HEAD + 6 * i], p[_HEAD + 6 * i + 1], p[_HEAD + 6 * i + 2],
+            p[_HEAD + 6 * i + 3], p[_HEAD + 6 * i + 4], p[_HEAD + 6 * i + 5],
+        )  # fmt: skip
+        if p[1] == _UNIVERSAL and i == s - 1:
+            continue
+        for j in range(6):
+            p[G + 6 * i + j] = _column_dot(T, p, 71, j)
+
+
+@njit(cache=True)
 def joint_residuals(g1, V1, g2, V2, p, pos, vel):  # type: ignore[no-untyped-def]
     """A joint's position residual Φ (s,) and velocity residual T V_rel (s,), written into
     ``pos`` and ``vel`` (module docstring; p packed by :meth:`Joint._kernel_params`)."""
@@ -289,14 +307,21 @@ def joint_rows(t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
             phi = _position_residual(p, s, a1, i, xi)
             b[i] -= p[ga + i] * vel + p[ga + s + i] * phi
     grounded = p[0] != 0.0
+    child = 0 if grounded else 6
+    G = _HEAD + 8 * s + 6  # the constant rows on the child, G = T Ad_{X_CJ⁻¹}
     for i in range(s):
         T = (
             _row_entry(p, s, a1, i, 0), _row_entry(p, s, a1, i, 1), _row_entry(p, s, a1, i, 2),
             _row_entry(p, s, a1, i, 3), _row_entry(p, s, a1, i, 4), _row_entry(p, s, a1, i, 5),
         )  # fmt: skip
+        if p[1] == _UNIVERSAL and i == s - 1:
+            for j in range(6):
+                A[i, child + j] = _column_dot(T, p, 71, j)
+        else:
+            for j in range(6):
+                A[i, child + j] = p[G + 6 * i + j]
         if grounded:
             for j in range(6):
-                A[i, j] = _column_dot(T, p, 71, j)  # T Ad_{X_CJ⁻¹}
                 A[i, 6 + j] = 0.0
             continue
         # u = T[i] Ad_{h⁻¹}: u_k = (T_ω + T_v × q) · (row k of R_h), u_{3+k} = T_v · (row k)
@@ -313,8 +338,15 @@ def joint_rows(t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
         )
         for j in range(6):
             A[i, j] = -_column_dot(u, p, 35, j)  # −T Ad_{h⁻¹} Ad_{X_PJ⁻¹}
-            A[i, 6 + j] = _column_dot(T, p, 71, j)  # T Ad_{X_CJ⁻¹}
     return 0
+
+
+@njit(cache=True)
+def _residuals_along(g1, V1, g2, V2, p, pos, vel):  # type: ignore[no-untyped-def]
+    """:func:`joint_residuals` at N states: g1, g2 (N, 4, 4), V1, V2 (N, 6), into pos and
+    vel (N, s)."""
+    for n in range(g1.shape[0]):
+        joint_residuals(g1[n], V1[n], g2[n], V2[n], p, pos[n], vel[n])
 
 
 def unwrap_with_rates(q: FloatArray, qd: FloatArray, t: FloatArray) -> FloatArray:
@@ -440,8 +472,10 @@ class Joint(Constraint):
                 self._alpha,
                 self._beta,
                 self._extra(),
+                np.zeros(6 * s),
             ]
         )
+        _child_rows(self._params)
         self._S_pinv = np.linalg.pinv(S) if S.shape[1] else np.zeros((0, 6))
 
     # -- what a kind defines
@@ -508,6 +542,28 @@ class Joint(Constraint):
             np.ascontiguousarray(Ad_CJ @ self._T.T),
             np.ascontiguousarray(Ad_CJ @ self.motion_subspace),
         )
+
+    def _violation_along(self, states: Sequence[State]) -> tuple[FloatArray, FloatArray] | None:
+        """:meth:`violation` at each of ``states`` (one System's), (N, s) each, in one compiled
+        loop (the drift check of a run evaluates up to 65 outputs); None for a subclass with
+        its own ``violation``."""
+        if type(self).violation is not Joint.violation or not states:
+            return None
+        layout = states[0].layout
+        if any(st.layout is not layout and st.layout != layout for st in states):
+            return None
+        idx = self._rigid_indices(states[0])
+        i, j = (idx[0], idx[0]) if self.grounded else idx
+        g = np.array([st.g for st in states], dtype=float)
+        V = np.array([st.V for st in states], dtype=float)
+        s = self._T.shape[0]
+        pos, vel = np.empty((len(states), s)), np.empty((len(states), s))
+        _residuals_along(
+            np.ascontiguousarray(g[:, i]), np.ascontiguousarray(V[:, i]),
+            np.ascontiguousarray(g[:, j]), np.ascontiguousarray(V[:, j]),
+            self._params, pos, vel,
+        )  # fmt: skip
+        return pos, vel
 
     # -- reading the joint
     def relative_pose(self, state: State) -> FloatArray:

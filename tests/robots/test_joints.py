@@ -413,3 +413,48 @@ def test_joint_rows_equal_the_matrix_product_reference(kind, grounded, stabilise
         joint_residuals(g1, V1, g2, V2, p, pos, vel)
         _close(pos[None], phi_ref[None])
         _close(vel[None], vel_ref[None])
+
+
+@pytest.mark.parametrize("grounded", [False, True])
+@pytest.mark.parametrize("kind", KINDS)
+def test_residuals_at_many_states_equal_one_state_at_a_time(kind, grounded):
+    """The drift check of a run evaluates the residuals at all its sampled outputs in one
+    compiled loop: the numbers of :meth:`Joint.violation` at each state, bit for bit."""
+    rng = np.random.default_rng([KINDS.index(kind), grounded])
+    parent = None if grounded else gmuk.RigidBody("P", 2.0, _inertia(rng))
+    child = gmuk.RigidBody("C", 1.0, _inertia(rng))
+    joint = _make(kind, parent, child, rng, baumgarte=gmuk.Baumgarte(alpha=1.0, beta=1.0))
+    system = gmuk.System([b for b in (parent, child) if b is not None], [joint])
+    states = [
+        system.state(
+            g={b.name: _pose(rng, 2.0) for b in system.bodies},
+            V={b.name: rng.normal(size=6) for b in system.bodies},
+        )
+        for _ in range(7)
+    ]
+    along = joint._violation_along(states)
+    assert along is not None
+    for n, state in enumerate(states):
+        pos, vel = joint.violation(state)
+        np.testing.assert_array_equal(along[0][n], pos)
+        np.testing.assert_array_equal(along[1][n], vel)
+
+
+class _OwnViolation(RevoluteJoint):
+    def violation(self, state):
+        pos, vel = super().violation(state)
+        return 2.0 * pos, vel
+
+
+def test_a_joint_with_its_own_violation_is_checked_one_state_at_a_time():
+    """A subclass's ``violation`` is what the drift check reports, not the kernel's."""
+    body = gmuk.RigidBody("C", 1.0, np.diag([1.0, 2.0, 3.0]))
+    joint = _OwnViolation(None, body)
+    system = gmuk.System([body], [joint])
+    state = system.state(g={"C": se3.exp(np.full(6, 0.1))}, V={"C": np.zeros(6)})
+    assert joint._violation_along([state]) is None
+    traj = system.simulate(state, (0.0, 0.01), t_eval=[0.0, 0.01], drift_tol=None)
+    (entry,) = traj.stats["constraint_violation"]["constraints"]
+    assert entry["initial_position"] == pytest.approx(
+        float(np.linalg.norm(joint.violation(state)[0])), rel=1e-12
+    )
