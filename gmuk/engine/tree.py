@@ -757,11 +757,7 @@ def _articulated_step(i, kk, p, s, kd, off, P, g, D, C, X, y, Ia, W, ws):  # typ
         f[u] = acc
     _ad_transpose_add(T, f, y[p])
     # D_p += Xᵀ I_a X, X = [[R, 0], [r̂R, R]]: Y = I_a X, then the lower triangle of Xᵀ Y
-    PR = ws[3]  # r̂R, column j at PR[3j : 3j + 3]
     r0, r1, r2 = T[3, 0], T[3, 1], T[3, 2]
-    for j in range(3):
-        PR[j] = r1 * T[2, j] - r2 * T[1, j]
-        PR[3 + j] = r2 * T[0, j] - r0 * T[2, j]
     Y = W  # W is spent: reuse it for Y (6 × 6)
     for u in range(6):
         for j in range(3):
