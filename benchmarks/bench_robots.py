@@ -279,18 +279,71 @@ def scaling(repeat: int, sizes: tuple[int, ...], dense_max: int) -> None:
         print(f"  {solver:5s} least-squares exponent over all n: call {call:.2f}, loop {loop:.2f}")
 
 
+def loop_rhs(repeat: int) -> None:
+    """The compiled right-hand side of the Panda's step loop alone (the tree solve), and the
+    poses by exp and dexp⁻¹ it takes, each called 20 000 times from a compiled loop."""
+    from numba import njit
+
+    from gmuk.engine.integrators import _compiled, get_method
+    from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
+
+    @njit
+    def rhs_loop(n, Y, G0, parts, dY, aux, ints):
+        for _ in range(n):
+            _compiled.rhs(0.0, Y, G0, parts, dY, aux, ints)
+
+    @njit
+    def exp_loop(n, G0, xi, g):
+        for _ in range(n):
+            _compose_exp_into(G0, xi, g)
+
+    @njit
+    def dexp_loop(n, xi, V, out):
+        for _ in range(n):
+            _dexp_inv_apply_into(xi, V, out)
+
+    path, base, locked = ROBOTS["panda"]
+    robot = Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked)
+    pin.seed(0)
+    model = robot.model
+    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+    state = robot.state(q, np.random.default_rng(0).normal(size=model.nv))
+    prog = robot.system.compiled_program(get_method("DOP853"), state)
+    _compiled.compile_loop()
+    nr = len(robot.system.bodies)
+    Y = np.zeros(prog.n)
+    Y[: 6 * nr] = 1e-3  # ξ ≠ 0: the poses by exp and dexp⁻¹ are computed
+    Y[6 * nr : 12 * nr] = np.asarray(state.V).ravel()
+    G0 = np.array(state.g)
+    xi, V = Y[: 6 * nr].reshape(nr, 6).copy(), Y[6 * nr : 12 * nr].reshape(nr, 6).copy()
+    ints = np.zeros(_compiled.N_INTS, np.int64)
+    cases = {
+        "the right-hand side": (rhs_loop, (Y, G0, prog.parts, np.empty(prog.n),
+                                           np.empty(prog.n_aux), ints)),
+        "poses by exp": (exp_loop, (G0, xi, np.empty((nr, 4, 4)))),
+        "dexp⁻¹": (dexp_loop, (xi, V, np.empty((nr, 6)))),
+    }  # fmt: skip
+    print("the Panda's compiled right-hand side, per call (medians of 20 000 calls)")
+    for label, (loop, args) in cases.items():
+        loop(10, *args)
+        t = _median_s(lambda f=loop, a=args: f(20_000, *a), repeat, 1) / 20_000
+        print(f"  {label:20s} {t * 1e6:6.2f} µs")
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--sizes", default="5,10,20,40,80,160,320,640,1000")
     parser.add_argument("--dense-max", type=int, default=40)
-    parser.add_argument("--only", default="call,parts,run,chain", help="which measurements")
+    parser.add_argument("--only", default="call,parts,rhs,run,chain", help="which measurements")
     args = parser.parse_args(argv)
     only = set(args.only.split(","))
     if "call" in only:
         one_call(args.repeat)
     if "parts" in only:
         breakdown(args.repeat)
+    if "rhs" in only:
+        loop_rhs(args.repeat)
     if "run" in only:
         panda_run(args.repeat)
     if "chain" in only:

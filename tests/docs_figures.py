@@ -2486,17 +2486,17 @@ ALLOWED += [
 
 # docs/robotics.rst, "Speed: the tree solve" ----------------------------------------------------
 TIMINGS += [
-    ("docs/robotics.rst", "grows as n^0.87 from 5 to 1000 links", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "against n^2.48 for the dense solve up to 40", "bench_robots.py"),
-    ("docs/robotics.rst", "call is 6.8–8.2 times", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "UR5 (52–160 times", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "2.0–2.5 times Pinocchio's ABA", "bench_robots*.py, 2026-11-29"),
-    ("docs/robotics.rst", "at the same tolerance (9 times with the", "bench_robots.py"),
-    ("docs/robotics.rst", "and 1.14–1.25 times MuJoCo's RK4", "bench_robots_mujoco.py, 2026-11-29"),
+    ("docs/robotics.rst", "grows as n^0.84 from 5 to 1000 links", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "against n^2.60 for the dense solve up to 40", "bench_robots.py"),
+    ("docs/robotics.rst", "call is 4.7–6.1 times", "bench_robots*.py, 2026-11-29"),
+    ("docs/robotics.rst", "UR5 (44–119 times", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "1.4–1.8 times Pinocchio's ABA", "bench_robots*.py, 2026-11-29"),
+    ("docs/robotics.rst", "at the same tolerance (8 times with the", "bench_robots.py"),
+    ("docs/robotics.rst", "and 0.84–0.88 times MuJoCo's RK4", "bench_robots_mujoco.py, 2026-11-29"),
     (
         "docs/robotics.rst",
-        "0.6 µs a joint in the step loop",
-        "bench_robots.py --only parts, 2026-11-29 (4.4 µs for the Panda's 7)",
+        "0.4 µs a joint in the step loop",
+        "bench_robots.py --only parts, 2026-11-29 (2.9 µs for the Panda's 7)",
     ),
 ]
 ALLOWED += [
