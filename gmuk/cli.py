@@ -633,6 +633,14 @@ def _add_view_parser(sub: Any) -> None:
         metavar="N",
         help="most animation frames; longer runs are decimated (default: 150)",
     )
+    view.add_argument(
+        "--link-radius",
+        type=scenarios.positive_float,
+        default=None,
+        metavar="M",
+        help="radius of the capsules drawn as a jointed run's links (m); default: a "
+        "fraction of the robot's reach",
+    )
 
 
 def _scenario_radius(name: object) -> float | None:
@@ -645,7 +653,7 @@ def _scenario_radius(name: object) -> float | None:
 
 def _view(args: argparse.Namespace) -> int:
     from gmuk.trajectory import load_trajectory
-    from gmuk.view import write_view
+    from gmuk.view import JOINT_FRAMES_KEY, write_view
 
     path: Path = args.path
     summary = path / "summary.json" if path.is_dir() else path.with_name("summary.json")
@@ -677,6 +685,11 @@ def _view(args: argparse.Namespace) -> int:
                 "view.html; give the .html file to write"
             )
     traj = load_trajectory(npz)
+    if args.link_radius is not None and not traj.stats.get(JOINT_FRAMES_KEY):
+        raise OptionError(
+            f"gmuk view: --link-radius sets the radius of a jointed run's links, and "
+            f"{str(npz)!r} records no joints (a run of gmuk.robots joints does)"
+        )
     try:
         written = write_view(
             traj,
@@ -684,6 +697,7 @@ def _view(args: argparse.Namespace) -> int:
             central_radius=radius,
             title=f"gmuk: {name}" if name else f"gmuk: {npz.name}",
             max_frames=args.max_frames,
+            link_radius=args.link_radius,
         )
     except OSError as exc:
         raise OptionError(

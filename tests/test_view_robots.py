@@ -531,3 +531,21 @@ def test_chromium_draws_and_animates_a_robot_view_with_no_script_error(chromium,
         link_pixels(image),
         link_pixels(bare),
     )
+
+
+def test_gmuk_view_takes_the_links_radius_and_refuses_it_without_joints(linkage, tmp_path, capsys):
+    from gmuk.cli import main
+
+    system, traj = linkage
+    npz = with_joint_frames(traj, system).save(tmp_path / "four_bar.npz")
+    assert main(["view", str(npz), "--link-radius", "0.02", "--out", str(tmp_path / "v.html")]) == 0
+    data, _ = figure((tmp_path / "v.html").read_text())
+    kept = decimate(len(traj), 150)
+    links, _, _ = expected_skeleton(system, traj.state(int(kept[0])), 0.05)
+    check_capsules(named(data, "links"), None, links, 0.02)
+    for bad in ("0", "-0.1", "nan", "inf", "wide"):
+        assert main(["view", str(npz), "--link-radius", bad]) == 2
+        assert "--link-radius" in capsys.readouterr().err
+    bare = traj.save(tmp_path / "bare.npz")  # no joints recorded
+    assert main(["view", str(bare), "--link-radius", "0.02"]) == 2
+    assert "records no joints" in capsys.readouterr().err
