@@ -690,7 +690,9 @@ def _articulated_step(i, kk, p, s, kd, off, P, g, D, C, X, y, Ia, W, ws):  # typ
     Schur complement as eliminating the body node and then the constraint node
     (Gᵀ (G D_i⁻¹ Gᵀ)⁻¹ G = I_a), with one k_d × k_d factor instead of a 6 × 6 and an s × s.
     Keeps D_i (full) in C[i], U in X[i], L in C[kk], R and r in X[kk]. False, with D[kk]
-    left zero, when N's Cholesky pivot is not certified."""
+    left zero, when a diagonal entry N_jj is not above PIVOT_TOL · max diag(D_i) · |S_j|²
+    (round-off of D_i's entries: the node steps' test on D_i would not pass either) or a
+    pivot of N's Cholesky factor is not certified."""
     sp = off + 6 * s
     Dc = C[i]
     for u in range(6):
@@ -711,8 +713,17 @@ def _articulated_step(i, kk, p, s, kd, off, P, g, D, C, X, y, Ia, W, ws):  # typ
             for v in range(6):
                 acc += P[sp + v * kd + j] * U[v, q]
             N[j, q] = acc
+    big = 0.0  # D_i's scale: N_jj at or below PIVOT_TOL of it is round-off of D_i's entries
+    for u in range(6):
+        big = max(big, Dc[u, u])
+    certified = True
+    for j in range(kd):
+        s2 = 0.0
+        for v in range(6):
+            s2 += P[sp + v * kd + j] * P[sp + v * kd + j]
+        certified = certified and N[j, j] > PIVOT_TOL * big * s2
     L = C[kk]
-    if not _cholesky(N, kd, 1.0, L):
+    if not (certified and _cholesky(N, kd, 1.0, L)):
         for j in range(kd):
             for q in range(kd):
                 N[j, q] = 0.0

@@ -473,3 +473,24 @@ def test_a_joint_with_rows_from_python_is_eliminated_node_by_node():
     system.accelerations(_random_state(system, 4))  # packs the row counts from Python
     assert _articulated(system) == [True, False, True, False]
     assert _PythonRevolute(None, "x")._tree_subspace() is None
+
+
+def test_a_joint_inertia_at_round_off_of_the_body_is_not_certified():
+    """A 1000 kg rod whose moment about the revolute axis (through its centre) is 1e-10
+    kg·m²: Sᵀ D S is below PIVOT_TOL of D's largest entry, at the round-off of D's entries.
+    The articulated step refuses it, as the node steps refuse D (the same pivot test), and
+    the solve is left to the dense one; a moment of 1e-6 kg·m² is certified and equals the
+    dense solve."""
+    for moment, certified in ((1e-10, False), (1e-6, True)):
+        rod = gmuk.RigidBody("rod", 1000.0, np.diag([moment, 1.0, 1.0]))
+        joint = RevoluteJoint(None, rod, axis=(1.0, 0.0, 0.0), child_frame=_half(-0.3))
+        parts = ([rod], [joint], [gmuk.UniformGravity((0.0, 0.0, -9.81))])
+        tree = gmuk.System(*parts, solver="tree")
+        twist = np.array([0.3, 0.1, -0.2, 0.0, 0.0, 0.0])
+        state = tree.state(g={"rod": np.eye(4)}, V={"rod": twist})
+        assert _articulated(tree) == [True]
+        (_, _, status), (_, _, status0) = _both_solves(tree, state)
+        assert (status == 0) is certified and status0 == status
+        if certified:
+            dense = gmuk.System(*parts, solver="dense")
+            _assert_same(tree.accelerations(state), dense.accelerations(state))
