@@ -691,8 +691,8 @@ def _articulated_step(i, kk, p, s, kd, off, P, g, D, C, X, y, Ia, W, ws):  # typ
     (Gᵀ (G D_i⁻¹ Gᵀ)⁻¹ G = I_a), with one k_d × k_d factor instead of a 6 × 6 and an s × s.
     Keeps D_i (full) in C[i], U in X[i], L in C[kk], R and r in X[kk]. False, with D[kk]
     left zero, when a diagonal entry N_jj is not above PIVOT_TOL · max diag(D_i) · |S_j|²
-    (round-off of D_i's entries: the node steps' test on D_i would not pass either) or a
-    pivot of N's Cholesky factor is not certified."""
+    (the round-off of D_i's entries, on the scale of the node steps' pivot test of D_i) or
+    a pivot of N's Cholesky factor is not certified."""
     sp = off + 6 * s
     Dc = C[i]
     for u in range(6):
