@@ -330,6 +330,41 @@ def loop_rhs(repeat: int) -> None:
         print(f"  {label:20s} {t * 1e6:6.2f} µs")
 
 
+def drift_check(repeat: int) -> None:
+    """A 1 s Panda run (tree solve, rtol = atol = 1e-10) with 101 and with 2 outputs, and the
+    drift check at the end of it (:func:`gmuk.engine.integrate.check_drift`, up to 65 sampled
+    outputs) timed alone on the 101-output trajectory."""
+    from gmuk.engine.integrate import check_drift
+    from gmuk.robots import Joint
+
+    path, base, locked = ROBOTS["panda"]
+    robot = Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked)
+    pin.seed(0)
+    model = robot.model
+    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+    state = robot.state(q, np.random.default_rng(0).normal(size=model.nv))
+    system = robot.system
+    print("1 s Panda run and its drift check (medians)")
+    for n in (101, 2):
+        t = np.linspace(0.0, 1.0, n)
+        traj = system.simulate(state, (0.0, 1.0), t_eval=t, rtol=1e-10, atol=1e-10)
+        t_run = _median_s(
+            lambda te=t: system.simulate(state, (0.0, 1.0), t_eval=te, rtol=1e-10, atol=1e-10),
+            repeat,
+            1,
+        )
+        t_check = _median_s(lambda tr=traj: check_drift(system, tr, 1e-6), repeat, 1)
+        along = Joint._violation_along
+        Joint._violation_along = lambda self, states: None  # each state through violation()
+        try:
+            t_one = _median_s(lambda tr=traj: check_drift(system, tr, 1e-6), repeat, 1)
+        finally:
+            Joint._violation_along = along
+        print(f"  {n:3d} outputs: run {t_run * 1e3:6.1f} ms ({traj.stats['n_rhs']} "
+              f"evaluations), drift check {t_check * 1e3:5.2f} ms (state by state: "
+              f"{t_one * 1e3:5.2f} ms)")  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
@@ -346,6 +381,8 @@ def main(argv: list[str] | None = None) -> None:
         loop_rhs(args.repeat)
     if "run" in only:
         panda_run(args.repeat)
+    if "drift" in only:
+        drift_check(args.repeat)
     if "chain" in only:
         scaling(args.repeat, tuple(int(s) for s in args.sizes.split(",")), args.dense_max)
 
