@@ -279,6 +279,16 @@ def scaling(repeat: int, sizes: tuple[int, ...], dense_max: int) -> None:
         print(f"  {solver:5s} least-squares exponent over all n: call {call:.2f}, loop {loop:.2f}")
 
 
+def _panda_at_seed_0() -> tuple[Robot, gmuk.State]:
+    """The Panda (tree solve) and its random state of seed 0 (Pinocchio's and numpy's)."""
+    path, base, locked = ROBOTS["panda"]
+    robot = Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked)
+    pin.seed(0)
+    model = robot.model
+    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+    return robot, robot.state(q, np.random.default_rng(0).normal(size=model.nv))
+
+
 def loop_rhs(repeat: int) -> None:
     """The compiled right-hand side of the Panda's step loop alone (the tree solve), and the
     poses by exp and dexp⁻¹ it takes, each called 20 000 times from a compiled loop."""
@@ -302,12 +312,7 @@ def loop_rhs(repeat: int) -> None:
         for _ in range(n):
             _dexp_inv_apply_into(xi, V, out)
 
-    path, base, locked = ROBOTS["panda"]
-    robot = Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked)
-    pin.seed(0)
-    model = robot.model
-    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
-    state = robot.state(q, np.random.default_rng(0).normal(size=model.nv))
+    robot, state = _panda_at_seed_0()
     prog = robot.system.compiled_program(get_method("DOP853"), state)
     _compiled.compile_loop()
     nr = len(robot.system.bodies)
@@ -332,17 +337,12 @@ def loop_rhs(repeat: int) -> None:
 
 def drift_check(repeat: int) -> None:
     """A 1 s Panda run (tree solve, rtol = atol = 1e-10) with 101 and with 2 outputs, and the
-    drift check at the end of it (:func:`gmuk.engine.integrate.check_drift`, up to 65 sampled
-    outputs) timed alone on the 101-output trajectory."""
+    drift check at the end of each (:func:`gmuk.engine.integrate.check_drift`, up to 65
+    sampled outputs) timed alone, batched and with each state through ``Joint.violation``."""
     from gmuk.engine.integrate import check_drift
     from gmuk.robots import Joint
 
-    path, base, locked = ROBOTS["panda"]
-    robot = Robot.from_urdf(example_robot_data(path), base=base, locked_joints=locked)
-    pin.seed(0)
-    model = robot.model
-    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
-    state = robot.state(q, np.random.default_rng(0).normal(size=model.nv))
+    robot, state = _panda_at_seed_0()
     system = robot.system
     print("1 s Panda run and its drift check (medians)")
     for n in (101, 2):

@@ -540,12 +540,13 @@ def _constraint_drift(con: Any, states: list[State], tol: float | None) -> dict[
             for level, values in zip(("position", "velocity"), both, strict=True):
                 v = np.linalg.norm(values, axis=1)
                 norms[level] = np.where(v == v, v, np.inf).tolist()
-        for s in states if both is None else ():
-            pos, vel = violation(s)
-            for level, value in (("position", pos), ("velocity", vel)):
-                if value is not None:
-                    v = float(np.linalg.norm(np.asarray(value, dtype=float)))
-                    norms[level].append(v if v == v else np.inf)
+        else:
+            for s in states:
+                pos, vel = violation(s)
+                for level, value in (("position", pos), ("velocity", vel)):
+                    if value is not None:
+                        v = float(np.linalg.norm(np.asarray(value, dtype=float)))
+                        norms[level].append(v if v == v else np.inf)
     except Exception as exc:  # a part's residual failing: recorded, the run is kept
         warnings.warn(
             f"the drift check of constraint {name!r} failed ({_describe(exc)}); not checked",
