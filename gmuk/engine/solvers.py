@@ -164,6 +164,9 @@ class Accelerations:
     rank: int | None
     unreachable: float
     z_dot: FloatArray
+    #: Set (in the instance) by a compiled call that has checked every entry is finite, so
+    #: that :meth:`gmuk.System.accelerations` does not scan them again.
+    _finite_checked: ClassVar[bool] = False
 
     @classmethod
     def _from_dict(cls, fields: dict[str, Any]) -> Accelerations:

@@ -894,7 +894,7 @@ class System:
                 f"the accelerations at t = {state.t:.9g} s overflow ({exc}; constraint rows or "
                 "loads too large for float64?)"
             ) from None
-        if not (
+        if not acc._finite_checked and not (
             all_finite(acc.total)
             and all_finite(acc.constraint_force)
             and all_finite(acc.multipliers)

@@ -1212,27 +1212,50 @@ def tree_loads_rows_rigid(t, g, V, terms, params, fdata, cons, cparams, P, A, b,
     return tree_rows_rigid(t, g, V, Q, cons, cparams, P, A, b, out)
 
 
+@njit(cache=True)
+def tree_state_rigid(t, g, V, terms, params, fdata, cons, cparams, P, out):  # type: ignore[no-untyped-def]
+    """:func:`tree_loads_rows_rigid` from a State's own read-only arrays, with the scratch
+    rows allocated here: writes ``out`` as :func:`tree_rigid` does (``out`` (4n + s + 3) sets
+    s) and returns 0 only when the call is solved and certified (status 0) and every entry
+    of ``out`` is finite, so that the caller need not scan them again; 1 otherwise (the
+    caller's general path then decides, and names what failed)."""
+    nb = V.shape[0]
+    s = out.shape[0] - 24 * nb - 3
+    A = np.zeros((s, 12))
+    b = np.empty(s)
+    if tree_loads_rows_rigid(
+        t, g.copy(), V.copy(), terms, params, fdata, cons, cparams, P, A, b, out
+    ) != 0 or out[-1] != 0.0:  # fmt: skip
+        return 1
+    for e in range(out.shape[0] - 1):
+        if not np.isfinite(out[e]):
+            return 1
+    return 0
+
+
 _I2 = types.Array(types.int64, 2, "C")
 _RO1 = types.Array(types.float64, 1, "C", readonly=True)
+_RO2 = types.Array(types.float64, 2, "C", readonly=True)
+_RO3 = types.Array(types.float64, 3, "C", readonly=True)
 #: The signature of :func:`tree_rows_rigid` as the System calls it.
 TREE_ROWS_SIGNATURE = types.int64(
     types.float64, _RW3, _RW2, _RW1, _I2, _RW1, _RW1, _RW2, _RW1, _RW1
 )
-#: The signature of :func:`tree_loads_rows_rigid` as the System calls it.
-TREE_LOADS_SIGNATURE = types.int64(
-    types.float64, _RW3, _RW2, _I2, _RW1, _RO1, _I2, _RW1, _RW1, _RW2, _RW1, _RW1
+#: The signature of :func:`tree_state_rigid` as the System calls it (a State's arrays).
+TREE_STATE_SIGNATURE = types.int64(
+    types.float64, _RO3, _RO2, _I2, _RW1, _RO1, _I2, _RW1, _RW1, _RW1
 )
 _tree_rows_c: Any = None
-_tree_loads_c: Any = None  # the entry of tree_loads_rows_rigid
+_tree_state_c: Any = None  # the entry of tree_state_rigid
 
 
-def _tree_loads_entry() -> Any:
-    """The compiled entry of :func:`tree_loads_rows_rigid` for :data:`TREE_LOADS_SIGNATURE`."""
-    global _tree_loads_c
-    if _tree_loads_c is None:
-        tree_loads_rows_rigid.compile(TREE_LOADS_SIGNATURE)
-        _tree_loads_c = tree_loads_rows_rigid.overloads[TREE_LOADS_SIGNATURE.args].entry_point
-    return _tree_loads_c
+def _tree_state_entry() -> Any:
+    """The compiled entry of :func:`tree_state_rigid` for :data:`TREE_STATE_SIGNATURE`."""
+    global _tree_state_c
+    if _tree_state_c is None:
+        tree_state_rigid.compile(TREE_STATE_SIGNATURE)
+        _tree_state_c = tree_state_rigid.overloads[TREE_STATE_SIGNATURE.args].entry_point
+    return _tree_state_c
 
 
 def _tree_rows_entry() -> Any:
@@ -1369,7 +1392,7 @@ class TreeSolver(UKSolver):
             plan, in_python = _program.force_terms(system._force_plan)
             if not in_python and all(term[3] for term in plan):  # rigid bodies only
                 self._loads_table = _program.pack_terms(plan)
-                _tree_loads_entry()
+                _tree_state_entry()
         from gmuk.engine.system import _pair
 
         self._pair = _pair
@@ -1462,27 +1485,17 @@ class TreeSolver(UKSolver):
         if self._loads_table is not None and self._cons is not None:
             terms, params, fdata = self._loads_table
             s, n = self._s, self._n
-            A, b = np.zeros((s, 12)), np.empty(s)
             out = np.empty(4 * n + s + 3)
+            g, V = state.g, state.V  # a State's own float64 arrays: C-contiguous unless built so
             if (
-                _tree_loads_c(
-                    float(state.t),
-                    np.array(state.g, dtype=float),  # writable copies: the kernels' types
-                    np.array(state.V, dtype=float),
-                    terms,
-                    params,
-                    fdata,
-                    self._cons,
-                    self._cparams,
-                    self._P,
-                    A,
-                    b,
-                    out,
-                )
-                == 0
-                and out[-1] == _SOLVED
-            ):
-                return self._solved(out, s, self._zero_loads)
+                g.flags.c_contiguous
+                and V.flags.c_contiguous
+                and _tree_state_c(
+                    float(state.t), g, V, terms, params, fdata, self._cons, self._cparams,
+                    self._P, out,
+                ) == 0
+            ):  # fmt: skip
+                return self._solved(out, s, self._zero_loads, finite=True)
             # a kernel failed or the call is not certified: the path below decides
         modeled, unmodeled = self._loads(state)
         if system._plant_only_loads:
@@ -1526,12 +1539,16 @@ class TreeSolver(UKSolver):
             self._not_finite(state)
         return self._general(state, modeled, unmodeled, _Blocks(A, b))
 
-    def _solved(self, out: FloatArray, s: int, unmodeled: FloatArray) -> Accelerations:
+    def _solved(
+        self, out: FloatArray, s: int, unmodeled: FloatArray, finite: bool = False
+    ) -> Accelerations:
         """The Accelerations of a certified compiled call (``out`` as :func:`tree_rigid`
-        writes it)."""
+        writes it); ``finite``: the call has checked that every entry of ``out`` is finite
+        (``Accelerations._finite_checked``)."""
         n = self._n
         return Accelerations._from_dict(
             {
+                "_finite_checked": finite,
                 "layout": self._lay,
                 "free": out[:n],
                 "constraint": out[n : 2 * n],

@@ -125,46 +125,84 @@ def _column_dot(x, p, o, j):  # type: ignore[no-untyped-def]
     )  # fmt: skip
 
 
-@njit(cache=True)
-def _joint_state(g1, V1, g2, V2, p):  # type: ignore[no-untyped-def]
-    """The relative pose h = g_Jp⁻¹ g_Jc (its three rows, 4-tuples), the translation q of
-    h⁻¹ (3-tuple), the twists
-    W = Ad_{h⁻¹} V_Jp (J_p's twist in J_c) and V_rel = V_Jc − W (6-tuples), and a₁ = R_hᵀ a₁ᵖ
-    (a universal joint's first axis in J_c; zero for another kind), with no array built."""
+@njit(cache=True, inline="always")
+def _joint_pose(g1, g2, p):  # type: ignore[no-untyped-def]
+    """The relative pose h = g_Jp⁻¹ g_Jc: its three rows (4-tuples)."""
     if p[0] != 0.0:  # to the ground: J_p is fixed in N
         P0, P1, P2 = _stored_row(p, 0, 3), _stored_row(p, 1, 3), _stored_row(p, 2, 3)
-        VJp = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         C0, C1, C2 = _frame_row(g1, 0, p, 19), _frame_row(g1, 1, p, 19), _frame_row(g1, 2, p, 19)
-        VJc = _apply(p, 71, V1)
     else:
         P0, P1, P2 = _frame_row(g1, 0, p, 3), _frame_row(g1, 1, p, 3), _frame_row(g1, 2, p, 3)
-        VJp = _apply(p, 35, V1)
         C0, C1, C2 = _frame_row(g2, 0, p, 19), _frame_row(g2, 1, p, 19), _frame_row(g2, 2, p, 19)
-        VJc = _apply(p, 71, V2)
-    h0 = _h_row(P0, P1, P2, C0, C1, C2, 0)
-    h1 = _h_row(P0, P1, P2, C0, C1, C2, 1)
-    h2 = _h_row(P0, P1, P2, C0, C1, C2, 2)
-    # Ad_{h⁻¹} = [[R_hᵀ, 0], [q^ R_hᵀ, R_hᵀ]], q = R_Jcᵀ (p_Jp − p_Jc) the translation of h⁻¹
-    q0 = C0[0] * (P0[3] - C0[3]) + C1[0] * (P1[3] - C1[3]) + C2[0] * (P2[3] - C2[3])
-    q1 = C0[1] * (P0[3] - C0[3]) + C1[1] * (P1[3] - C1[3]) + C2[1] * (P2[3] - C2[3])
-    q2 = C0[2] * (P0[3] - C0[3]) + C1[2] * (P1[3] - C1[3]) + C2[2] * (P2[3] - C2[3])
-    x0 = h0[0] * VJp[0] + h1[0] * VJp[1] + h2[0] * VJp[2]  # R_hᵀ ω_Jp
-    x1 = h0[1] * VJp[0] + h1[1] * VJp[1] + h2[1] * VJp[2]
-    x2 = h0[2] * VJp[0] + h1[2] * VJp[1] + h2[2] * VJp[2]
-    y0 = h0[0] * VJp[3] + h1[0] * VJp[4] + h2[0] * VJp[5] + (q1 * x2 - q2 * x1)
-    y1 = h0[1] * VJp[3] + h1[1] * VJp[4] + h2[1] * VJp[5] + (q2 * x0 - q0 * x2)
-    y2 = h0[2] * VJp[3] + h1[2] * VJp[4] + h2[2] * VJp[5] + (q0 * x1 - q1 * x0)
-    W = (x0, x1, x2, y0, y1, y2)
-    Vr = (VJc[0] - x0, VJc[1] - x1, VJc[2] - x2, VJc[3] - y0, VJc[4] - y1, VJc[5] - y2)
+    return (
+        _h_row(P0, P1, P2, C0, C1, C2, 0),
+        _h_row(P0, P1, P2, C0, C1, C2, 1),
+        _h_row(P0, P1, P2, C0, C1, C2, 2),
+    )
+
+
+@njit(cache=True, inline="always")
+def _joint_state(g1, V1, g2, V2, p):  # type: ignore[no-untyped-def]
+    """X = Ad_{g_C⁻¹ g_P} as R = R_Cᵀ R_P (9-tuple, row by row) and r = R_Cᵀ (p_P − p_C)
+    (3-tuple; g_P = I for a joint to the ground), the twists W = Ad_{X_CJ⁻¹} X V_P (J_p's
+    twist in J_c, = Ad_{h⁻¹} V_Jp) and V_rel = Ad_{X_CJ⁻¹} V_C − W (6-tuples), and
+    a₁ = R_hᵀ a₁ᵖ = R_{X_CJ}ᵀ R R_{X_PJ} a₁ᵖ (a universal joint's first axis in J_c; zero for
+    another kind), with no array built. Through X the rows on the parent are −G X, with G the
+    constant rows on the child (h⁻¹ X_PJ⁻¹ = X_CJ⁻¹ g_C⁻¹ g_P)."""
+    grounded = p[0] != 0.0
+    gc = g1 if grounded else g2
+    Vc = V1 if grounded else V2
+    if grounded:  # g_P = I: R = R_Cᵀ, r = −R_Cᵀ p_C, and the parent does not move
+        R = (gc[0, 0], gc[1, 0], gc[2, 0], gc[0, 1], gc[1, 1], gc[2, 1],
+             gc[0, 2], gc[1, 2], gc[2, 2])  # fmt: skip
+        d0, d1, d2 = -gc[0, 3], -gc[1, 3], -gc[2, 3]
+    else:
+        R = (
+            gc[0, 0] * g1[0, 0] + gc[1, 0] * g1[1, 0] + gc[2, 0] * g1[2, 0],
+            gc[0, 0] * g1[0, 1] + gc[1, 0] * g1[1, 1] + gc[2, 0] * g1[2, 1],
+            gc[0, 0] * g1[0, 2] + gc[1, 0] * g1[1, 2] + gc[2, 0] * g1[2, 2],
+            gc[0, 1] * g1[0, 0] + gc[1, 1] * g1[1, 0] + gc[2, 1] * g1[2, 0],
+            gc[0, 1] * g1[0, 1] + gc[1, 1] * g1[1, 1] + gc[2, 1] * g1[2, 1],
+            gc[0, 1] * g1[0, 2] + gc[1, 1] * g1[1, 2] + gc[2, 1] * g1[2, 2],
+            gc[0, 2] * g1[0, 0] + gc[1, 2] * g1[1, 0] + gc[2, 2] * g1[2, 0],
+            gc[0, 2] * g1[0, 1] + gc[1, 2] * g1[1, 1] + gc[2, 2] * g1[2, 1],
+            gc[0, 2] * g1[0, 2] + gc[1, 2] * g1[1, 2] + gc[2, 2] * g1[2, 2],
+        )
+        d0, d1, d2 = g1[0, 3] - gc[0, 3], g1[1, 3] - gc[1, 3], g1[2, 3] - gc[2, 3]
+    r = (
+        gc[0, 0] * d0 + gc[1, 0] * d1 + gc[2, 0] * d2,
+        gc[0, 1] * d0 + gc[1, 1] * d1 + gc[2, 1] * d2,
+        gc[0, 2] * d0 + gc[1, 2] * d1 + gc[2, 2] * d2,
+    )
+    XV = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    if not grounded:  # X V_P = [R ω_P; R v_P + r × R ω_P]
+        w0 = R[0] * V1[0] + R[1] * V1[1] + R[2] * V1[2]
+        w1 = R[3] * V1[0] + R[4] * V1[1] + R[5] * V1[2]
+        w2 = R[6] * V1[0] + R[7] * V1[1] + R[8] * V1[2]
+        XV = (
+            w0, w1, w2,
+            R[0] * V1[3] + R[1] * V1[4] + R[2] * V1[5] + (r[1] * w2 - r[2] * w1),
+            R[3] * V1[3] + R[4] * V1[4] + R[5] * V1[5] + (r[2] * w0 - r[0] * w2),
+            R[6] * V1[3] + R[7] * V1[4] + R[8] * V1[5] + (r[0] * w1 - r[1] * w0),
+        )  # fmt: skip
+    W = _apply(p, 71, XV)
+    VJc = _apply(p, 71, Vc)
+    Vr = (VJc[0] - W[0], VJc[1] - W[1], VJc[2] - W[2], VJc[3] - W[3], VJc[4] - W[4], VJc[5] - W[5])
     a1 = (0.0, 0.0, 0.0)
     if p[1] == _UNIVERSAL:
         e = _HEAD + 8 * int(p[2])
+        u0 = p[3] * p[e] + p[4] * p[e + 1] + p[5] * p[e + 2]  # R_{X_PJ} a₁ᵖ
+        u1 = p[7] * p[e] + p[8] * p[e + 1] + p[9] * p[e + 2]
+        u2 = p[11] * p[e] + p[12] * p[e + 1] + p[13] * p[e + 2]
+        x0 = R[0] * u0 + R[1] * u1 + R[2] * u2
+        x1 = R[3] * u0 + R[4] * u1 + R[5] * u2
+        x2 = R[6] * u0 + R[7] * u1 + R[8] * u2
         a1 = (
-            h0[0] * p[e] + h1[0] * p[e + 1] + h2[0] * p[e + 2],
-            h0[1] * p[e] + h1[1] * p[e + 1] + h2[1] * p[e + 2],
-            h0[2] * p[e] + h1[2] * p[e + 1] + h2[2] * p[e + 2],
+            p[19] * x0 + p[23] * x1 + p[27] * x2,
+            p[20] * x0 + p[24] * x1 + p[28] * x2,
+            p[21] * x0 + p[25] * x1 + p[29] * x2,
         )
-    return h0, h1, h2, (q0, q1, q2), W, Vr, a1
+    return R, r, W, Vr, a1
 
 
 @njit(cache=True, inline="always")
@@ -253,7 +291,8 @@ def joint_residuals(g1, V1, g2, V2, p, pos, vel):  # type: ignore[no-untyped-def
     """A joint's position residual Φ (s,) and velocity residual T V_rel (s,), written into
     ``pos`` and ``vel`` (module docstring; p packed by :meth:`Joint._kernel_params`)."""
     s = int(p[2])
-    h0, h1, h2, _q, _W, Vr, a1 = _joint_state(g1, V1, g2, V2, p)
+    _R, _r, _W, Vr, a1 = _joint_state(g1, V1, g2, V2, p)
+    h0, h1, h2 = _joint_pose(g1, g2, p)
     xi = _log_residual(p, h0, h1, h2, np.empty(44))
     for i in range(s):
         pos[i] = _position_residual(p, s, a1, i, xi)
@@ -268,11 +307,13 @@ def joint_rows(t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
     The rows of a relative constraint between the joint frames (the math of
     :func:`gmuk.constraints.relative.relative_rows` with a_des = 0),
     ``[−T Ad_{h⁻¹}, T]`` and ``T r`` with ``r = −ad_{V_rel} W``, ``W = Ad_{h⁻¹} V_Jp``, mapped
-    to the bodies' twists by ``Ad_{X_PJ⁻¹}`` and ``Ad_{X_CJ⁻¹}``. Written entry by entry into
-    A and b with no array allocated: A serves as scratch for the log of the position residual
-    before its rows are written (12 s ≥ 36 entries; ≥ 44 for the screw joint's s = 5)."""
+    to the bodies' twists by ``Ad_{X_PJ⁻¹}`` and ``Ad_{X_CJ⁻¹}``: ``[−G X, G]`` with the
+    constant G = T Ad_{X_CJ⁻¹} and X = Ad_{g_C⁻¹ g_P} (:func:`_joint_state`). Written entry
+    by entry into A and b with no array allocated: A serves as scratch for the log of the
+    position residual before its rows are written (12 s ≥ 36 entries; ≥ 44 for the screw
+    joint's s = 5)."""
     s = int(p[2])
-    h0, h1, h2, q, W, Vr, a1 = _joint_state(g1, V1, g2, V2, p)
+    R, rr, W, Vr, a1 = _joint_state(g1, V1, g2, V2, p)
     w0, w1, w2, v0, v1, v2 = Vr
     x0, x1, x2, y0, y1, y2 = W
     r = (
@@ -301,6 +342,7 @@ def joint_rows(t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
         if p[ga + i] != 0.0 or p[ga + s + i] != 0.0:
             stabilised = True
     if stabilised:
+        h0, h1, h2 = _joint_pose(g1, g2, p)
         xi = _log_residual(p, h0, h1, h2, A.reshape(A.size))
         for i in range(s):
             vel = _row_dot(p, s, a1, i, Vr)
@@ -324,20 +366,15 @@ def joint_rows(t, g1, V1, g2, V2, p, A, b):  # type: ignore[no-untyped-def]
             for j in range(6):
                 A[i, 6 + j] = 0.0
             continue
-        # u = T[i] Ad_{h⁻¹}: u_k = (T_ω + T_v × q) · (row k of R_h), u_{3+k} = T_v · (row k)
-        z0 = T[0] + (T[4] * q[2] - T[5] * q[1])
-        z1 = T[1] + (T[5] * q[0] - T[3] * q[2])
-        z2 = T[2] + (T[3] * q[1] - T[4] * q[0])
-        u = (
-            z0 * h0[0] + z1 * h0[1] + z2 * h0[2],
-            z0 * h1[0] + z1 * h1[1] + z2 * h1[2],
-            z0 * h2[0] + z1 * h2[1] + z2 * h2[2],
-            T[3] * h0[0] + T[4] * h0[1] + T[5] * h0[2],
-            T[3] * h1[0] + T[4] * h1[1] + T[5] * h1[2],
-            T[3] * h2[0] + T[4] * h2[1] + T[5] * h2[2],
-        )
-        for j in range(6):
-            A[i, j] = -_column_dot(u, p, 35, j)  # −T Ad_{h⁻¹} Ad_{X_PJ⁻¹}
+        # −G_i X = −[(G_ω + G_v × r)ᵀ R, G_vᵀ R] for the row G_i = [G_ω, G_v] on the child
+        G0, G1, G2 = A[i, child], A[i, child + 1], A[i, child + 2]
+        G3, G4, G5 = A[i, child + 3], A[i, child + 4], A[i, child + 5]
+        z0 = G0 + (G4 * rr[2] - G5 * rr[1])
+        z1 = G1 + (G5 * rr[0] - G3 * rr[2])
+        z2 = G2 + (G3 * rr[1] - G4 * rr[0])
+        for j in range(3):
+            A[i, j] = -(z0 * R[j] + z1 * R[3 + j] + z2 * R[6 + j])
+            A[i, 3 + j] = -(G3 * R[j] + G4 * R[3 + j] + G5 * R[6 + j])
     return 0
 
 

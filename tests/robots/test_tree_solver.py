@@ -23,7 +23,7 @@ from gmuk.engine.tree import (
     tree_solve,
     tree_structure,
 )
-from gmuk.errors import DefinitionError
+from gmuk.errors import DefinitionError, NonFiniteError
 from gmuk.lie import se3
 from gmuk.robots import (
     CylindricalJoint,
@@ -494,3 +494,24 @@ def test_a_joint_inertia_at_round_off_of_the_body_is_not_certified():
         if certified:
             dense = gmuk.System(*parts, solver="dense")
             _assert_same(tree.accelerations(state), dense.accelerations(state))
+
+
+def test_the_one_call_path_never_returns_an_acceleration_that_overflowed():
+    """Finite rows, a weight that overflows: the compiled one-call path (loads, rows and solve
+    from the State's arrays) must not hand back inf; the general path names the failure."""
+    link = gmuk.RigidBody("link", 1e300, np.diag([1.0, 2.0, 3.0]) * 1e300)
+    hinge = RevoluteJoint(None, link, axis=[0.0, 1.0, 0.0])
+    system = gmuk.System([link], [hinge], [gmuk.UniformGravity([0.0, 0.0, -1e300])], solver="tree")
+    assert system.solver._loads_table is not None  # the one-call path is the one taken
+    state = system.state(g={"link": np.eye(4)}, V={"link": [0.0, 1.0, 0.0, 0.0, 0.0, 0.0]})
+    with pytest.raises(NonFiniteError, match=r"non-finite|overflow"):
+        system.accelerations(state)
+    # and a finite call through the same path is certified without a second scan
+    light = gmuk.System(
+        [gmuk.RigidBody("link", 1.0, np.diag([1.0, 2.0, 3.0]))],
+        [RevoluteJoint(None, "link", axis=[0.0, 1.0, 0.0])],
+        [gmuk.UniformGravity()],
+        solver="tree",
+    )
+    acc = light.accelerations(light.state(g={"link": np.eye(4)}, V={"link": np.zeros(6)}))
+    assert acc._finite_checked and np.all(np.isfinite(acc.total))
