@@ -442,3 +442,36 @@ def kernel_caller(signature: Any, kind: str) -> Any:
 
     call.__name__ = call.__qualname__ = f"call_{kind.replace(' ', '_')}_kernel"
     return intrinsic(call)
+
+
+def _borrowed(typingctx, array):  # type: ignore[no-untyped-def]
+    """``array`` as a borrowed reference: the same data, shape and strides with no memory
+    owner, so that the views taken of it (``a[i]``, ``a[i:j]``) and the calls it is passed to
+    skip the atomic reference counting of numba's runtime. Each increment and decrement is a
+    locked instruction, and the row kernels and the tree solve take views in their inner
+    loops: counting them was half the time of a robot's evaluation.
+
+    Only for an array that outlives every use of the result, as a function's argument does
+    during the call (its caller holds it): a borrowed array must not be returned, stored in
+    a container or given to Python, which would hold memory no one owns."""
+    if not isinstance(array, types.Array):
+        return None
+
+    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+        src = context.make_array(sig.args[0])(context, builder, value=args[0])
+        out = context.make_array(sig.return_type)(context, builder)
+        context.populate_array(
+            out,
+            data=src.data,
+            shape=src.shape,
+            strides=src.strides,
+            itemsize=src.itemsize,
+            meminfo=None,
+        )
+        return out._getvalue()
+
+    return array(array), codegen
+
+
+#: :func:`_borrowed` as the intrinsic the kernels call: ``borrowed(array)``.
+borrowed: Any = intrinsic(_borrowed)

@@ -827,7 +827,7 @@ _add(
 _add(
     "docs/robotics.rst",
     "panda",
-    ("3.2e-10 rad", "pinocchio_max_q_difference_rad", "{:.1e} rad", "within"),
+    ("3.1e-10 rad", "pinocchio_max_q_difference_rad", "{:.1e} rad", "within"),
     ("84.5 J", "energy_dissipated_J", "{:.1f} J", "dissipate"),
 )
 

@@ -65,7 +65,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numba import types
 
-from gmuk._numba import kernel_address, kernel_caller, njit
+from gmuk._numba import borrowed, kernel_address, kernel_caller, njit
 from gmuk._validation import FloatArray, all_finite
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import ROWS_KERNEL, as_rows
@@ -889,6 +889,33 @@ def tree_solve(
     (‖A(a + ν̇_c) − b‖₂, scale of the consistency test, status): status 0 solved, 1 not
     certified (a pivot, or a constraint with more than six rows), 2 A or b not finite.
     """
+    nn = int(P[2]) + int(P[3])
+    return _tree_solve(
+        g, a, rhs, A, b, P, ac, lam,
+        np.empty((3, nn), dtype=np.int64),
+        np.empty((3, nn, 6, 6)),
+        np.zeros((nn, 6)),
+        np.zeros((3, nn), dtype=np.bool_),
+        np.empty((17, 6)),
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _tree_solve(g, a, rhs, A, b, P, ac, lam, index, blocks, y, flags, scratch):  # type: ignore[no-untyped-def]
+    """:func:`tree_solve` with its work arrays (index (3, n_n) int64, blocks (3, n_n, 6, 6),
+    y (n_n, 6) zero, flags (3, n_n) False, scratch (17, 6)) from the caller, which holds
+    them and every argument for the call: all are used as :func:`gmuk._numba.borrowed`
+    references, so that the views of the elimination count no references."""
+    g, a, rhs, A, b, P = (
+        borrowed(g),
+        borrowed(a),
+        borrowed(rhs),
+        borrowed(A),
+        borrowed(b),
+        borrowed(P),
+    )
+    ac, lam, index, blocks = borrowed(ac), borrowed(lam), borrowed(index), borrowed(blocks)
+    y, flags, scratch = borrowed(y), borrowed(flags), borrowed(scratch)
     nb = int(P[2])
     nc = int(P[3])
     nn = nb + nc
@@ -905,7 +932,6 @@ def tree_solve(
     body_a = P[o : o + nc]
     body_b = P[o + nc : o + 2 * nc]
     nrow = P[o + 2 * nc : o + 3 * nc]
-    index = np.empty((3, nn), dtype=np.int64)
     row0 = index[0, :nc]
     dim = index[1]
     up = index[2]  # the parent in the back-substitution
@@ -921,12 +947,10 @@ def tree_solve(
         return np.nan, np.nan, _failed(A, b)
     for i in range(nb):
         dim[i] = 6
-    blocks = np.empty((3, nn, 6, 6))
     D = blocks[0]
     C = blocks[1]
     X = blocks[2]
     D[:] = 0.0
-    y = np.zeros((nn, 6))
     for i in range(nb):  # D_i = M_i = blkdiag(J_i, m_i I)
         for u in range(3):
             for v in range(3):
@@ -936,7 +960,6 @@ def tree_solve(
     if n_singular:  # the bodies' right-hand side r_i, zero where M_i is invertible
         for e in range(6 * nb):
             y[e // 6, e % 6] = rhs[e]
-    flags = np.zeros((3, nn), dtype=np.bool_)
     merged = flags[0]  # a constraint node eliminated with its child
     articulated = flags[1]  # a body eliminated with its joint
     stored = flags[2]  # X_i = D_i⁻¹ H_ip kept (eliminated pairs)
@@ -953,7 +976,6 @@ def tree_solve(
                 if ib >= 0:
                     acc -= A[row, 6 + e] * a[6 * ib + e]
             y[nb + k, u] = acc
-    scratch = np.empty((17, 6))
     H = scratch[0:6]  # H_ip (d_i × d_p)
     W = scratch[6:12]  # L_i⁻¹ H_ip
     col = scratch[12]
@@ -1080,6 +1102,8 @@ def tree_rigid(
     residual, scale, status]``, status 3 when solved but ``residual > consistency_tol ·
     scale``; the other entries are meaningful only for status 0 and 3 (the layout of
     :func:`gmuk.engine._uk_kernels.uk_rigid`)."""
+    g, V, Q, A, b = borrowed(g), borrowed(V), borrowed(Q), borrowed(A), borrowed(b)
+    P, out = borrowed(P), borrowed(out)
     nb = V.shape[0]
     n = 6 * nb
     s = b.shape[0]
@@ -1119,6 +1143,7 @@ def kernel_rows(t, g, V, cons, cparams, c, Ak, bk):  # type: ignore[no-untyped-d
     """Constraint ``c`` of the table ``cons`` by its compiled kernel: its rows on its first
     body (columns 0–5 of Ak (nrow, 12)) and its second (6–11), b into bk. Returns the
     kernel's status (0: written)."""
+    g, V, cparams = borrowed(g), borrowed(V), borrowed(cparams)  # views for the kernel
     i, j, p0 = cons[c, 1], cons[c, 2], cons[c, 5]
     second = j if j >= 0 else i
     return _call_rows(cons[c, 0], (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
@@ -1129,6 +1154,7 @@ def constraint_block(t, g, V, cons, cparams, c, A, b):  # type: ignore[no-untype
     """Constraint ``c``'s rows by :func:`kernel_rows` into its block of the tree's A (s, 12)
     and b (s,), from row ``cons[c, 3]`` (the kernel writes into the block itself; columns
     6–11 are zeroed after it for a constraint on one body). Returns the kernel's status."""
+    A, b = borrowed(A), borrowed(b)  # their row blocks are views for the kernel
     r0, nrow = cons[c, 3], cons[c, 4]
     status = kernel_rows(t, g, V, cons, cparams, c, A[r0 : r0 + nrow], b[r0 : r0 + nrow])
     if status != 0:
@@ -1162,6 +1188,14 @@ def tree_rows_rigid(
     parameters in ``cparams``, as the compiled loop's constraint table does; the rows go into
     A (s, 12) and b (s,), the results into ``out`` as :func:`tree_rigid` writes them. Returns
     0, or the status of a constraint kernel that failed (then ``out`` is not written)."""
+    g, V, Q, cons, cparams = (
+        borrowed(g),
+        borrowed(V),
+        borrowed(Q),
+        borrowed(cons),
+        borrowed(cparams),
+    )
+    P, A, b, out = borrowed(P), borrowed(A), borrowed(b), borrowed(out)
     for c in range(cons.shape[0]):
         status = constraint_block(t, g, V, cons, cparams, c, A, b)
         if status != 0:
@@ -1181,6 +1215,13 @@ def rigid_loads(t, g, V, terms, params, fdata, P, Q):  # type: ignore[no-untyped
     offset, modeled, parameter start, field start, field end), each kernel called as the
     compiled loop calls it, with the body's mass and inertia from P. Returns 0, or the status
     of a kernel that failed."""
+    g, V, params, fdata, P = (
+        borrowed(g),
+        borrowed(V),
+        borrowed(params),
+        borrowed(fdata),
+        borrowed(P),
+    )
     nb = V.shape[0]
     J = P[_HEAD : _HEAD + 9 * nb].reshape((nb, 3, 3))
     m = P[_HEAD + 18 * nb : _HEAD + 19 * nb]
@@ -1205,6 +1246,21 @@ def tree_loads_rows_rigid(t, g, V, terms, params, fdata, cons, cparams, P, A, b,
     accelerations, for a System whose force models and constraints all have a compiled
     form and whose loads all go through the solve. Returns 0, or the status of a kernel that
     failed (then ``out`` is not written)."""
+    g, V, terms, params, fdata = (
+        borrowed(g),
+        borrowed(V),
+        borrowed(terms),
+        borrowed(params),
+        borrowed(fdata),
+    )
+    cons, cparams, P, A, b, out = (
+        borrowed(cons),
+        borrowed(cparams),
+        borrowed(P),
+        borrowed(A),
+        borrowed(b),
+        borrowed(out),
+    )
     Q = np.empty(6 * V.shape[0])
     status = rigid_loads(t, g, V, terms, params, fdata, P, Q)
     if status != 0:

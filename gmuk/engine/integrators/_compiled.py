@@ -52,7 +52,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-from gmuk._numba import kernel_address, kernel_caller, njit
+from gmuk._numba import borrowed, kernel_address, kernel_caller, njit
 from gmuk.control.base import CONTROL_KERNEL
 from gmuk.dynamics import rigid_free_accel
 from gmuk.engine._uk_kernels import _qr_solve, uk_rigid
@@ -204,9 +204,15 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
     :class:`Status`: DONE, NONFINITE, CALLBACK, or FIELD with the failed kernel's status in
     ``ints[I_FIELD]``."""
     d = parts.dims
-    terms, params, fdata = parts.terms, parts.params, parts.field_data
-    J, Jinv, m_r, m_e = parts.J, parts.Jinv, parts.m_rigid, parts.m_euclid
-    r_off, e_off, io = parts.rigid_offsets, parts.euclid_offsets, parts.io
+    # borrowed references (gmuk._numba.borrowed): the caller holds the arguments for the
+    # call, and the views taken of them below then count no references
+    Y, G0, dY, aux, ints = borrowed(Y), borrowed(G0), borrowed(dY), borrowed(aux), borrowed(ints)
+    terms, params = borrowed(parts.terms), borrowed(parts.params)
+    fdata = borrowed(parts.field_data)
+    J, Jinv = borrowed(parts.J), borrowed(parts.Jinv)
+    m_r, m_e = borrowed(parts.m_rigid), borrowed(parts.m_euclid)
+    r_off, e_off = borrowed(parts.rigid_offsets), borrowed(parts.euclid_offsets)
+    io = borrowed(parts.io)
     nr, ne, ndof, s, nc = d.n_rigid, d.n_euclid, d.n_dof, d.n_rows, d.n_control
     total = aux[:ndof]
     # views of Y, not copies: nothing is allocated per evaluation that a view can replace
@@ -484,6 +490,14 @@ def _constraint_blocks(t, g, V, cons, cparams, io, r_off, P, A, b):  # type: ign
     rows on its first body (columns 0–5 of A (s, 12)) and its second (6–11), computed by its
     kernel or copied from the dense rows PythonParts wrote into ``io`` (the bodies from the
     packed tree ``P``). Returns 0 or the status of a failed kernel."""
+    g, V, cparams, io, A, b = (
+        borrowed(g),
+        borrowed(V),
+        borrowed(cparams),
+        borrowed(io),
+        borrowed(A),
+        borrowed(b),
+    )
     ndof = 6 * r_off.shape[0]  # rigid bodies only
     for c in range(cons.shape[0]):
         kind, r0, nrow, p0 = cons[c, 0], cons[c, 3], cons[c, 4], cons[c, 5]
