@@ -2486,17 +2486,22 @@ ALLOWED += [
 
 # docs/robotics.rst, "Speed: the tree solve" ----------------------------------------------------
 TIMINGS += [
-    ("docs/robotics.rst", "grows as n^0.84 from 5 to 1000 links", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "against n^2.60 for the dense solve up to 40", "bench_robots.py"),
-    ("docs/robotics.rst", "call is 4.7–6.1 times", "bench_robots*.py, 2026-11-29"),
-    ("docs/robotics.rst", "UR5 (44–119 times", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "1.4–1.8 times Pinocchio's ABA", "bench_robots*.py, 2026-11-29"),
-    ("docs/robotics.rst", "at the same tolerance (8 times with the", "bench_robots.py"),
-    ("docs/robotics.rst", "and 0.84–0.88 times MuJoCo's RK4", "bench_robots_mujoco.py, 2026-11-29"),
     (
         "docs/robotics.rst",
-        "0.4 µs a joint in the step loop",
-        "bench_robots.py --only parts, 2026-11-29 (2.9 µs for the Panda's 7)",
+        "grows as n^0.94 from 5 to 1000 links",
+        "bench_robots.py --only chain, 2026-11-29",
+    ),
+    ("docs/robotics.rst", "against n^2.33 for the dense solve up to 40", "bench_robots.py"),
+    ("docs/robotics.rst", "call is 3.4–4.3 times", "bench_robots*.py, 2026-11-29, commit 05923a2"),
+    ("docs/robotics.rst", "3.6 and 4.1 times on the UR5 and Solo12", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "34–134 times with the dense", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "1.1–1.2 times Pinocchio's ABA", "bench_robots*.py, 2026-11-29"),
+    ("docs/robotics.rst", "tolerance (9 times with the dense solve)", "bench_robots.py"),
+    ("docs/robotics.rst", "and 0.55–0.59 times MuJoCo's RK4", "bench_robots_mujoco.py, 2026-11-29"),
+    (
+        "docs/robotics.rst",
+        "0.3 µs a joint in the step loop",
+        "bench_robots.py --only parts, 2026-11-29 (2.2 µs for the Panda's 7)",
     ),
 ]
 ALLOWED += [
