@@ -387,6 +387,9 @@ def kernel_address(kernel: Any, signature: Any) -> int:
     """
     from gmuk.errors import DefinitionError
 
+    known = _ADDRESSES.get((id(kernel), id(signature)))
+    if known is not None and known[0] is kernel and known[1] is signature:
+        return known[2]
     name = getattr(kernel, "__qualname__", repr(kernel))
     try:
         if signature.args not in kernel.overloads:
@@ -401,7 +404,16 @@ def kernel_address(kernel: Any, signature: Any) -> int:
             f"kernel {name} returns {cres.signature.return_type}; its kind of part asks for "
             f"{signature.return_type}"
         )
-    return int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+    address = int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+    # the objects themselves are kept with the address, so that an id reused after one of
+    # them is gone cannot match: compiled code stays loaded for the process
+    _ADDRESSES[(id(kernel), id(signature))] = (kernel, signature, address)
+    return address
+
+
+#: kernel_address's answers, by the ids of the kernel and the signature (numba's types hash
+#: slowly, and a run packs the address of each of its parts)
+_ADDRESSES: dict[tuple[int, int], tuple[Any, Any, int]] = {}
 
 
 def kernel_caller(signature: Any, kind: str) -> Any:
@@ -444,22 +456,24 @@ def kernel_caller(signature: Any, kind: str) -> Any:
     return intrinsic(call)
 
 
-def _borrowed(typingctx, array):  # type: ignore[no-untyped-def]
-    """``array`` as a borrowed reference: the same data, shape and strides with no memory
-    owner, so that the views taken of it (``a[i]``, ``a[i:j]``) and the calls it is passed to
-    skip the atomic reference counting of numba's runtime. Each increment and decrement is a
-    locked instruction, and the row kernels and the tree solve take views in their inner
-    loops: counting them was half the time of a robot's evaluation.
+def _holds_arrays(ty: Any) -> bool:
+    """Whether a numba type is an array or a tuple (or named tuple) holding one."""
+    if isinstance(ty, types.Array):
+        return True
+    return isinstance(ty, types.BaseTuple) and any(_holds_arrays(t) for t in _members(ty))
 
-    Only for an array that outlives every use of the result, as a function's argument does
-    during the call (its caller holds it): a borrowed array must not be returned, stored in
-    a container or given to Python, which would hold memory no one owns."""
-    if not isinstance(array, types.Array):
-        return None
 
-    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
-        src = context.make_array(sig.args[0])(context, builder, value=args[0])
-        out = context.make_array(sig.return_type)(context, builder)
+def _members(ty: Any) -> tuple[Any, ...]:
+    """The member types of a numba tuple or named tuple type."""
+    return tuple(ty.types)
+
+
+def _borrow_value(context: Any, builder: Any, ty: Any, value: Any) -> Any:
+    """The LLVM value of type ``ty`` with every array in it (itself, or the members of a
+    tuple, recursively) rebuilt with no memory owner."""
+    if isinstance(ty, types.Array):
+        src = context.make_array(ty)(context, builder, value=value)
+        out = context.make_array(ty)(context, builder)
         context.populate_array(
             out,
             data=src.data,
@@ -469,6 +483,30 @@ def _borrowed(typingctx, array):  # type: ignore[no-untyped-def]
             meminfo=None,
         )
         return out._getvalue()
+    for i, member in enumerate(_members(ty)):
+        if _holds_arrays(member):
+            item = builder.extract_value(value, i)
+            value = builder.insert_value(value, _borrow_value(context, builder, member, item), i)
+    return value
+
+
+def _borrowed(typingctx, array):  # type: ignore[no-untyped-def]
+    """``array`` as a borrowed reference: the same data, shape and strides with no memory
+    owner, so that the views taken of it (``a[i]``, ``a[i:j]``) and the calls it is passed to
+    skip the atomic reference counting of numba's runtime. Each increment and decrement is a
+    locked instruction, and the row kernels and the tree solve take views in their inner
+    loops: counting them was half the time of a robot's evaluation. A tuple or named tuple
+    (the compiled loop's records) comes back with each array in it borrowed: a call counts
+    every array of a record it is handed, on entry and on exit.
+
+    Only for an array that outlives every use of the result, as a function's argument does
+    during the call (its caller holds it): a borrowed array must not be returned, stored in
+    a container or given to Python, which would hold memory no one owns."""
+    if not _holds_arrays(array):
+        return None
+
+    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+        return _borrow_value(context, builder, sig.args[0], args[0])
 
     return array(array), codegen
 

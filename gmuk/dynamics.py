@@ -118,13 +118,24 @@ def body_moment(
 def rigid_free_accel(
     V: np.ndarray, J: np.ndarray, Jinv: np.ndarray, m: np.ndarray, Q: np.ndarray
 ) -> np.ndarray:
-    """V̇ = 𝕀⁻¹(ad*_V 𝕀 V + Q) for n rigid bodies: (n, 6) twists and wrenches → (n, 6).
+    """V̇ = 𝕀⁻¹(ad*_V 𝕀V + Q) for n rigid bodies: (n, 6) twists and wrenches → (n, 6)
+    (:func:`rigid_free_accel_into` into a new array)."""
+    out = np.empty((V.shape[0], 6))
+    rigid_free_accel_into(V, J, Jinv, m, Q, out)
+    return out
+
+
+@njit(cache=True)
+def rigid_free_accel_into(
+    V: np.ndarray, J: np.ndarray, Jinv: np.ndarray, m: np.ndarray, Q: np.ndarray, out: np.ndarray
+) -> None:
+    """V̇ = 𝕀⁻¹(ad*_V 𝕀V + Q) for n rigid bodies, (n, 6) twists and wrenches, into ``out``
+    (n, 6) (rad/s², m/s²; body frames).
 
     ad*_V 𝕀V = [Jω × ω; m v × ω] (McCann 2020, Eq. 10b, written out); 𝕀⁻¹ takes J⁺ and
     1/m = 0 for a body with a singular mass block (its solve supplies the rest).
     """
     n = V.shape[0]
-    out = np.empty((n, 6))
     for k in range(n):
         w0, w1, w2 = V[k, 0], V[k, 1], V[k, 2]
         v0, v1, v2 = V[k, 3], V[k, 4], V[k, 5]
@@ -135,7 +146,6 @@ def rigid_free_accel(
         out[k, 3] = v1 * w2 - v2 * w1 + Q[k, 3] * im
         out[k, 4] = v2 * w0 - v0 * w2 + Q[k, 4] * im
         out[k, 5] = v0 * w1 - v1 * w0 + Q[k, 5] * im
-    return out
 
 
 def check_inertia(

@@ -289,13 +289,13 @@ class Trajectory:
         i = strict_integer(i, what)
         if not -n <= i < n:
             raise DefinitionError(f"output index {i} out of range for {n} outputs")
-        return State(
+        return State._adopt(  # fresh copies, which the State makes read-only and keeps
             float(self.t[i]),
-            self.g_NB[i].copy(),
-            self.V_B[i].copy(),
-            self.x[i].copy(),
-            self.xdot[i].copy(),
-            self.z[i].copy(),
+            np.array(self.g_NB[i], dtype=np.float64),
+            np.array(self.V_B[i], dtype=np.float64),
+            np.array(self.x[i], dtype=np.float64),
+            np.array(self.xdot[i], dtype=np.float64),
+            np.array(self.z[i], dtype=np.float64),
             self.layout,
         )
 

@@ -2488,21 +2488,16 @@ ALLOWED += [
 TIMINGS += [
     (
         "docs/robotics.rst",
-        "grows as n^0.94 from 5 to 1000 links",
-        "bench_robots.py --only chain, 2026-11-29",
+        "grows as n^0.91 from 5 to 1000 links",
+        "bench_robots.py --only chain, 2026-11-29 (loop evaluation; the call 0.89)",
     ),
-    ("docs/robotics.rst", "against n^2.33 for the dense solve up to 40", "bench_robots.py"),
-    ("docs/robotics.rst", "call is 3.4–4.3 times", "bench_robots*.py, 2026-11-29, commit 05923a2"),
-    ("docs/robotics.rst", "3.6 and 4.1 times on the UR5 and Solo12", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "34–134 times with the dense", "bench_robots.py, 2026-11-29"),
-    ("docs/robotics.rst", "1.1–1.2 times Pinocchio's ABA", "bench_robots*.py, 2026-11-29"),
-    ("docs/robotics.rst", "tolerance (9 times with the dense solve)", "bench_robots.py"),
-    ("docs/robotics.rst", "and 0.55–0.59 times MuJoCo's RK4", "bench_robots_mujoco.py, 2026-11-29"),
-    (
-        "docs/robotics.rst",
-        "0.3 µs a joint in the step loop",
-        "bench_robots.py --only parts, 2026-11-29 (2.2 µs for the Panda's 7)",
-    ),
+    ("docs/robotics.rst", "against n^2.79 for the dense solve up to 40", "bench_robots.py"),
+    ("docs/robotics.rst", "call is 2.8–2.9 times", "bench_robots*.py, 2026-11-29 (one work array)"),
+    ("docs/robotics.rst", "2.9 times on the UR5 and 2.6 times on Solo12", "bench_robots.py"),
+    ("docs/robotics.rst", "48–131 times with the dense", "bench_robots.py, 2026-11-29"),
+    ("docs/robotics.rst", "0.89–0.94 times Pinocchio's ABA", "bench_robots*.py, 2026-11-29"),
+    ("docs/robotics.rst", "tolerance (8 times with the dense solve)", "bench_robots.py"),
+    ("docs/robotics.rst", "0.42–0.50 times MuJoCo's RK4", "bench_robots_mujoco.py, 2026-11-29"),
 ]
 ALLOWED += [
     ("docs/robotics.rst", "It equals the dense solve to 1e-12", _THRESHOLD + " (the tests')"),

@@ -438,3 +438,24 @@ def test_batched_calls_equal_a_loop_over_elements(name, make_input):
             single = f(x[i, j])
             assert out[i, j].shape == single.shape
             assert_close(out[i, j], single, tol=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("name", "short"),
+    [("C", _kernels._C_SHORT), ("D", _kernels._D_SHORT), ("E", _kernels._E_SHORT)],
+)
+def test_the_short_series_drop_only_terms_below_the_last_bit(name, short):
+    """Below θ² = _SHORT_BELOW the kernels sum the series' leading terms only: the dropped
+    ones add less than a quarter of the last bit, so that both sums round alike (to 1 ulp)
+    over the whole range, and the dropped terms' bound holds at its end."""
+    full = getattr(_kernels, f"_{name}")
+    assert 0 < len(short) < len(full) and full[len(full) - len(short) :] == short
+    x_max = _kernels._SHORT_BELOW
+    lowest_first = full[::-1]
+    dropped = sum(abs(c) * x_max**k for k, c in enumerate(lowest_first) if k >= len(short))
+    low = abs(lowest_first[0]) - sum(abs(c) * x_max**k for k, c in enumerate(lowest_first) if k)
+    assert dropped < 2.0**-56 * low
+    horner = _kernels._horner.py_func  # the kernels' sum, run in Python
+    for x in np.linspace(0.0, x_max, 2001):
+        a, b = horner(short, float(x)), horner(full, float(x))
+        assert abs(a - b) <= np.spacing(abs(b)), (name, x)

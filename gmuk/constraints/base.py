@@ -206,6 +206,8 @@ class Constraint(FreezesInSystem, DeclaresForms, abc.ABC):
         if packed is None:
             return None
         params, n_rows = packed
+        if isinstance(params, np.ndarray) and params.dtype == np.float64 and params.ndim == 1:
+            return kernel, tuple(params.tolist()), int(n_rows)  # the common case, at once
         return kernel, tuple(float(v) for v in params), int(n_rows)
 
     def _tree_subspace(self) -> Any:

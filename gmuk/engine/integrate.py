@@ -480,8 +480,10 @@ def check_drift(system: System, traj: Trajectory, drift_tol: float | None) -> Tr
     n = len(traj)
     picks = np.arange(n) if n <= DRIFT_SAMPLES else np.linspace(0, n - 1, DRIFT_SAMPLES)
     idx = np.unique(np.round(picks).astype(np.int64))
-    states = [traj.state(int(i)) for i in idx] if system.constraints else []
-    found = [_constraint_drift(c, states, drift_tol) for c in system.constraints]
+    states = _SampledStates(traj, idx) if system.constraints else _SampledStates(traj, idx[:0])
+    # the poses and twists at those times, stacked once for every constraint
+    stacked = (traj.g_NB[idx], traj.V_B[idx]) if len(states) else None
+    found = [_constraint_drift(c, states, drift_tol, stacked) for c in system.constraints]
     entries = [e for e in found if e is not None]
 
     def largest(level: str) -> float | None:
@@ -525,9 +527,38 @@ def _show(value: float | None) -> str:
     return "n/a" if value is None else f"{value:.3g}"
 
 
-def _constraint_drift(con: Any, states: list[State], tol: float | None) -> dict[str, Any] | None:
+class _SampledStates(Sequence[State]):
+    """The States of a trajectory at the output indices ``idx``, each made when first read
+    (a constraint that reads its residuals from the stacked arrays reads only the first)."""
+
+    def __init__(self, traj: Trajectory, idx: Any) -> None:
+        self._traj = traj
+        self._idx = [int(i) for i in idx]
+        self._made: dict[int, State] = {}
+        self.times = traj.t[idx]
+
+    def __len__(self) -> int:
+        return len(self._idx)
+
+    def __getitem__(self, k: Any) -> Any:
+        if isinstance(k, slice):
+            return [self[j] for j in range(*k.indices(len(self)))]
+        k = range(len(self))[k]  # an IndexError out of range, negative k from the end
+        state = self._made.get(k)
+        if state is None:
+            state = self._made[k] = self._traj.state(self._idx[k])
+        return state
+
+
+def _constraint_drift(
+    con: Any,
+    states: Sequence[State],
+    tol: float | None,
+    stacked: tuple[FloatArray, FloatArray] | None = None,
+) -> dict[str, Any] | None:
     """One constraint's entry of the drift check over ``states``; None when it states no
-    residual."""
+    residual. ``stacked``: the states' poses (N, n_rigid, 4, 4) and twists (N, n_rigid, 6),
+    for a constraint that reads its residuals at every state at once."""
     violation = getattr(con, "violation", None)
     if violation is None or not states:
         return None
@@ -535,7 +566,7 @@ def _constraint_drift(con: Any, states: list[State], tol: float | None) -> dict[
     norms: dict[str, list[float]] = {"position": [], "velocity": []}
     try:
         along = getattr(con, "_violation_along", None)  # the residuals at every state at once
-        both = along(states) if along is not None else None
+        both = along(states, stacked) if along is not None else None
         if both is not None:
             for level, values in zip(("position", "velocity"), both, strict=True):
                 v = np.linalg.norm(values, axis=1)
@@ -558,7 +589,7 @@ def _constraint_drift(con: Any, states: list[State], tol: float | None) -> dict[
                 "t_drifted": None, "error": _describe(exc)}  # fmt: skip
     if not norms["position"] and not norms["velocity"]:
         return None
-    times = np.array([s.t for s in states])
+    times = states.times if isinstance(states, _SampledStates) else np.array([s.t for s in states])
     start = {k: (v[0] if v else None) for k, v in norms.items()}
     on_start = all(v is None or v <= tol for v in start.values()) if tol is not None else None
     t_drifted = None
@@ -610,19 +641,24 @@ def _describe(exc: BaseException) -> str:
 
 def _times(t_eval: Any) -> FloatArray:
     """``t_eval`` as a 1-D float array of finite real times, or a DefinitionError."""
-    bad = DefinitionError(f"t_eval must be an array of finite real times (s); got {t_eval!r:.60}")
+
+    def bad() -> DefinitionError:  # made only when raised: the repr of a long array is slow
+        return DefinitionError(
+            f"t_eval must be an array of finite real times (s); got {t_eval!r:.60}"
+        )
+
     try:
         raw = np.asarray(t_eval)
     except (TypeError, ValueError, OverflowError):
-        raise bad from None
+        raise bad() from None
     if raw.dtype.kind not in "iuf":
-        raise bad
+        raise bad()
     try:
         outs = raw.astype(float).reshape(-1)
     except OverflowError:
-        raise bad from None
+        raise bad() from None
     if not np.isfinite(outs).all():
-        raise bad
+        raise bad()
     return outs
 
 

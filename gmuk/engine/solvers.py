@@ -176,6 +176,52 @@ class Accelerations:
         object.__setattr__(obj, "__dict__", fields)
         return obj
 
+    @classmethod
+    def _packed(cls, out: FloatArray, n: int, s: int, shared: dict[str, Any]) -> Accelerations:
+        """The Accelerations of a compiled call that wrote, in ``out``, ν̇_a, ν̇_c, ν̇ and the
+        constraint wrench (n each), λ (s), then the residual (``out[-3]``), every entry
+        checked finite; ``shared`` holds the fields that do not depend on the state (layout,
+        extra, control_force, unmodeled_force, unreachable, z_dot). Each field is made the
+        first time it is read (:meth:`_unpack`): a call costs one allocation and this object."""
+        obj = object.__new__(cls)
+        obj.__dict__.update(_finite_checked=True, _out=out, _ns=(n, s), _shared=shared)
+        return obj
+
+    def _unpack(self, name: str) -> Any:
+        """Field ``name`` of a :meth:`_packed` object, kept once made (AttributeError for a
+        name that is not one of its fields)."""
+        fields = self.__dict__
+        out = fields.get("_out")
+        if out is None:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        n, s = fields["_ns"]
+        if name == "free":
+            value: Any = out[:n]
+        elif name == "constraint":
+            value = out[n : 2 * n]
+        elif name == "total":
+            value = out[2 * n : 3 * n]
+        elif name == "constraint_force":
+            value = out[3 * n : 4 * n]
+        elif name == "multipliers":
+            value = out[4 * n : 4 * n + s]
+        elif name == "residual":
+            value = float(out[-3])
+        elif name == "rank":
+            value = s
+        elif name in fields["_shared"]:
+            value = fields["_shared"][name]
+        else:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        fields[name] = value
+        return value
+
+    if not TYPE_CHECKING:  # (mypy would otherwise accept any attribute name)
+
+        def __getattr__(self, name: str) -> Any:
+            # called only for a name missing from the instance: a packed field not read yet
+            return self._unpack(name)
+
     def of(self, body: Body | str, field: str = "total") -> FloatArray:
         """The slice of a per-dof field (e.g. "total", "constraint_force") for one body."""
         s = self.layout.slot(body)

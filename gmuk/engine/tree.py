@@ -43,7 +43,7 @@ takes M⁺, the loads M⁺ leaves go on its node's right-hand side (:func:`body_
 its D_i has no Cholesky factor it is eliminated together with the constraint to its parent as
 one node, by the null-space method on that constraint's rows (:func:`_eliminate_pair`); the
 KKT system keeps its tree, and the solve its linear cost. When every force model has a
-compiled form, :func:`tree_loads_rows_rigid` evaluates the loads, the rows and the solve in
+compiled form, :func:`tree_state_rigid` evaluates the loads, the rows and the solve in
 one compiled call.
 
 The multipliers are the Udwadia–Kalaba ones (``λ = (A M⁻¹ Aᵀ)⁻¹ (b − A ν̇_a)``, Eq. 3 of
@@ -69,7 +69,7 @@ from gmuk._numba import borrowed, kernel_address, kernel_caller, njit
 from gmuk._validation import FloatArray, all_finite
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import ROWS_KERNEL, as_rows
-from gmuk.dynamics import body_moment, rigid_free_accel
+from gmuk.dynamics import body_moment, rigid_free_accel_into
 from gmuk.engine import _uk_kernels, uk
 from gmuk.engine._uk_kernels import consistency_scale
 from gmuk.engine.solvers import (
@@ -126,6 +126,7 @@ _RW3 = types.Array(types.float64, 3, "C")
 TREE_SIGNATURE = types.void(_RW3, _RW2, _RW1, _RW2, _RW1, _RW1, _RW1)
 _tree_rigid_c: Any = None
 
+_packed = Accelerations._packed  # (bound once: a classmethod is bound at each lookup)
 _SOLVED = float(SolveStatus.SOLVED)
 _NOT_FINITE = float(SolveStatus.NOT_FINITE)
 
@@ -889,23 +890,26 @@ def tree_solve(
     (‖A(a + ν̇_c) − b‖₂, scale of the consistency test, status): status 0 solved, 1 not
     certified (a pivot, or a constraint with more than six rows), 2 A or b not finite.
     """
-    nn = int(P[2]) + int(P[3])
+    n_float, n_int = tree_work_sizes(P)
     return _tree_solve(
-        g, a, rhs, A, b, P, ac, lam,
-        np.empty((3, nn), dtype=np.int64),
-        np.empty((3, nn, 6, 6)),
-        np.zeros((nn, 6)),
-        np.zeros((3, nn), dtype=np.bool_),
-        np.empty((17, 6)),
-    )  # fmt: skip
+        g, a, rhs, A, b, P, ac, lam, np.empty(n_float), np.empty(n_int, dtype=np.int64)
+    )
+
+
+@njit(cache=True, inline="always")
+def tree_work_sizes(P: np.ndarray) -> tuple[int, int]:
+    """The sizes of the float64 and int64 work arrays :func:`_tree_solve` takes for the
+    packed tree P: (114 n_n + 102, 6 n_n) for its n_n nodes (bodies and constraints)."""
+    nn = int(P[2]) + int(P[3])
+    return 114 * nn + 102, 6 * nn
 
 
 @njit(cache=True)
-def _tree_solve(g, a, rhs, A, b, P, ac, lam, index, blocks, y, flags, scratch):  # type: ignore[no-untyped-def]
-    """:func:`tree_solve` with its work arrays (index (3, n_n) int64, blocks (3, n_n, 6, 6),
-    y (n_n, 6) zero, flags (3, n_n) False, scratch (17, 6)) from the caller, which holds
-    them and every argument for the call: all are used as :func:`gmuk._numba.borrowed`
-    references, so that the views of the elimination count no references."""
+def _tree_solve(g, a, rhs, A, b, P, ac, lam, fwork, iwork):  # type: ignore[no-untyped-def]
+    """:func:`tree_solve` with its work arrays from the caller (``fwork`` float64 and
+    ``iwork`` int64, 1-D, at least :func:`tree_work_sizes` long), which holds them and every
+    argument for the call: all are used as :func:`gmuk._numba.borrowed` references, so that
+    the views of the elimination count no references."""
     g, a, rhs, A, b, P = (
         borrowed(g),
         borrowed(a),
@@ -914,8 +918,7 @@ def _tree_solve(g, a, rhs, A, b, P, ac, lam, index, blocks, y, flags, scratch): 
         borrowed(b),
         borrowed(P),
     )
-    ac, lam, index, blocks = borrowed(ac), borrowed(lam), borrowed(index), borrowed(blocks)
-    y, flags, scratch = borrowed(y), borrowed(flags), borrowed(scratch)
+    ac, lam, fwork, iwork = borrowed(ac), borrowed(lam), borrowed(fwork), borrowed(iwork)
     nb = int(P[2])
     nc = int(P[3])
     nn = nb + nc
@@ -932,6 +935,15 @@ def _tree_solve(g, a, rhs, A, b, P, ac, lam, index, blocks, y, flags, scratch): 
     body_a = P[o : o + nc]
     body_b = P[o + nc : o + 2 * nc]
     nrow = P[o + 2 * nc : o + 3 * nc]
+    index = iwork[: 3 * nn].reshape((3, nn))
+    flags = iwork[3 * nn : 6 * nn].reshape((3, nn))  # 0 or 1
+    blocks = fwork[: 108 * nn].reshape((3, nn, 6, 6))
+    y = fwork[108 * nn : 114 * nn].reshape((nn, 6))
+    scratch = fwork[114 * nn : 114 * nn + 102].reshape((17, 6))
+    for i in range(nn):
+        flags[0, i] = flags[1, i] = flags[2, i] = 0
+        for u in range(6):
+            y[i, u] = 0.0
     row0 = index[0, :nc]
     dim = index[1]
     up = index[2]  # the parent in the back-substitution
@@ -982,7 +994,7 @@ def _tree_solve(g, a, rhs, A, b, P, ac, lam, index, blocks, y, flags, scratch): 
     ws = scratch[13:17]
     for step in range(nn):
         i = int(order[step])
-        if merged[i]:
+        if merged[i] != 0:
             continue
         if i < nb and int(parent[i]) >= nb:  # a body below a joint it can be eliminated with
             kk = int(parent[i])
@@ -995,8 +1007,8 @@ def _tree_solve(g, a, rhs, A, b, P, ac, lam, index, blocks, y, flags, scratch): 
                 else:
                     ok = _articulated_step(i, kk, p, sk, kd, off, P, g, D, C, X, y, H, W, ws)
                 if ok:
-                    merged[kk] = True
-                    articulated[i] = True
+                    merged[kk] = 1
+                    articulated[i] = 1
                     up[i] = p
                     continue
         di = dim[i]
@@ -1016,15 +1028,15 @@ def _tree_solve(g, a, rhs, A, b, P, ac, lam, index, blocks, y, flags, scratch): 
             # a singular body's D_i: eliminate it with its joint to the parent, one node
             if not _eliminate_pair(i, p, int(parent[p]), nb, A, row0, body_a, dim, D, C, X, y):
                 return np.nan, np.nan, _failed(A, b)
-            merged[p] = True
-            stored[i] = True
-            stored[p] = True
+            merged[p] = 1
+            stored[i] = 1
+            stored[p] = 1
             up[i] = int(parent[p])
     # x_i = z_i − D_i⁻¹ H_ip x_p (X_i x_p where stored), roots first (y holds z, then x)
     for step in range(nn - 1, -1, -1):
         i = int(order[step])
         p = up[i]
-        if articulated[i]:
+        if articulated[i] != 0:
             kk = int(parent[i])
             _half, kd, off = _joint_subspace(P, kk - nb)
             if dim[kk] == 5:
@@ -1032,11 +1044,11 @@ def _tree_solve(g, a, rhs, A, b, P, ac, lam, index, blocks, y, flags, scratch): 
             else:
                 _articulated_back(i, kk, p, dim[kk], kd, off, P, C, X, y, ws)
             continue
-        if p < 0 or (merged[i] and not stored[i]):
+        if p < 0 or (merged[i] != 0 and stored[i] == 0):
             continue
         di = dim[i]
         dp = dim[p]
-        if stored[i]:
+        if stored[i] != 0:
             for u in range(di):
                 acc = 0.0
                 for v in range(dp):
@@ -1102,8 +1114,19 @@ def tree_rigid(
     residual, scale, status]``, status 3 when solved but ``residual > consistency_tol ·
     scale``; the other entries are meaningful only for status 0 and 3 (the layout of
     :func:`gmuk.engine._uk_kernels.uk_rigid`)."""
+    n_float, n_int = tree_work_sizes(P)
+    _tree_rigid(
+        g, V, Q, A, b, P, out, np.empty(12 * V.shape[0] + n_float), np.empty(n_int, np.int64)
+    )
+
+
+@njit(cache=True)
+def _tree_rigid(g, V, Q, A, b, P, out, work, iwork):  # type: ignore[no-untyped-def]
+    """:func:`tree_rigid` with its work arrays from the caller, which holds them and every
+    argument for the call (``work`` at least 12 n_b + the float work of
+    :func:`tree_work_sizes`, ``iwork`` its int work)."""
     g, V, Q, A, b = borrowed(g), borrowed(V), borrowed(Q), borrowed(A), borrowed(b)
-    P, out = borrowed(P), borrowed(out)
+    P, out, work, iwork = borrowed(P), borrowed(out), borrowed(work), borrowed(iwork)
     nb = V.shape[0]
     n = 6 * nb
     s = b.shape[0]
@@ -1111,12 +1134,17 @@ def tree_rigid(
     J = P[o : o + 9 * nb].reshape((nb, 3, 3))
     Jinv = P[o + 9 * nb : o + 18 * nb].reshape((nb, 3, 3))
     m = P[o + 18 * nb : o + 19 * nb]
-    a = rigid_free_accel(V, J, Jinv, m, Q.reshape((nb, 6))).reshape(-1)
+    a = work[:n]
+    rhs = work[n : 2 * n]
+    rigid_free_accel_into(V, J, Jinv, m, Q.reshape((nb, 6)), a.reshape((nb, 6)))
     ac = out[n : 2 * n]
-    rhs = np.zeros(n)
+    for e in range(n):
+        rhs[e] = 0.0
     if P[singular_at(P)] != 0.0:  # bodies with a singular mass block
         body_rhs(V, Q, a, P, rhs)
-    residual, scale, status = tree_solve(g, a, rhs, A, b, P, ac, out[4 * n : 4 * n + s])
+    residual, scale, status = _tree_solve(
+        g, a, rhs, A, b, P, ac, out[4 * n : 4 * n + s], work[2 * n :], iwork
+    )
     for k in range(nb):
         for i in range(6):
             r = 6 * k + i
@@ -1138,7 +1166,7 @@ def tree_rigid(
 _call_rows = kernel_caller(ROWS_KERNEL, "constraint")
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def kernel_rows(t, g, V, cons, cparams, c, Ak, bk):  # type: ignore[no-untyped-def]
     """Constraint ``c`` of the table ``cons`` by its compiled kernel: its rows on its first
     body (columns 0–5 of Ak (nrow, 12)) and its second (6–11), b into bk. Returns the
@@ -1149,12 +1177,20 @@ def kernel_rows(t, g, V, cons, cparams, c, Ak, bk):  # type: ignore[no-untyped-d
     return _call_rows(cons[c, 0], (t, g[i], V[i], g[second], V[second], cparams[p0:], Ak, bk))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def constraint_block(t, g, V, cons, cparams, c, A, b):  # type: ignore[no-untyped-def]
     """Constraint ``c``'s rows by :func:`kernel_rows` into its block of the tree's A (s, 12)
     and b (s,), from row ``cons[c, 3]`` (the kernel writes into the block itself; columns
     6–11 are zeroed after it for a constraint on one body). Returns the kernel's status."""
-    A, b = borrowed(A), borrowed(b)  # their row blocks are views for the kernel
+    # the caller holds the arguments: their views (the row blocks) count no references
+    g, V, cons, cparams, A, b = (
+        borrowed(g),
+        borrowed(V),
+        borrowed(cons),
+        borrowed(cparams),
+        borrowed(A),
+        borrowed(b),
+    )
     r0, nrow = cons[c, 3], cons[c, 4]
     status = kernel_rows(t, g, V, cons, cparams, c, A[r0 : r0 + nrow], b[r0 : r0 + nrow])
     if status != 0:
@@ -1196,11 +1232,21 @@ def tree_rows_rigid(
         borrowed(cparams),
     )
     P, A, b, out = borrowed(P), borrowed(A), borrowed(b), borrowed(out)
+    status = _blocks_of_rows(t, g, V, cons, cparams, A, b)
+    if status != 0:
+        return status
+    tree_rigid(g, V, Q, A, b, P, out)
+    return 0
+
+
+@njit(cache=True)
+def _blocks_of_rows(t, g, V, cons, cparams, A, b):  # type: ignore[no-untyped-def]
+    """Every constraint of the table ``cons`` by :func:`constraint_block` into A and b.
+    Returns 0, or the status of the first kernel that failed."""
     for c in range(cons.shape[0]):
         status = constraint_block(t, g, V, cons, cparams, c, A, b)
         if status != 0:
             return status
-    tree_rigid(g, V, Q, A, b, P, out)
     return 0
 
 
@@ -1208,26 +1254,26 @@ _call_force = kernel_caller(FORCE_KERNEL, "force model")
 
 
 @njit(cache=True)
-def rigid_loads(t, g, V, terms, params, fdata, P, Q):  # type: ignore[no-untyped-def]
+def rigid_loads(t, g, V, terms, params, fdata, P, Q, w):  # type: ignore[no-untyped-def]
     """Q (6 n_b,) ← the sum of the compiled force terms' wrenches [τ; f] (N·m, N, body
     frames) at the poses g (n_b, 4, 4) and twists V (n_b, 6): the table ``terms`` (n, 8) of
     :func:`gmuk.engine.integrators._program.pack_terms` (kernel address, rigid, body, ν
     offset, modeled, parameter start, field start, field end), each kernel called as the
-    compiled loop calls it, with the body's mass and inertia from P. Returns 0, or the status
-    of a kernel that failed."""
-    g, V, params, fdata, P = (
+    compiled loop calls it, with the body's mass and inertia from P, writing into ``w`` (6,).
+    Returns 0, or the status of a kernel that failed."""
+    g, V, terms, params, fdata = (
         borrowed(g),
         borrowed(V),
+        borrowed(terms),
         borrowed(params),
         borrowed(fdata),
-        borrowed(P),
     )
+    P, Q, w = borrowed(P), borrowed(Q), borrowed(w)
     nb = V.shape[0]
     J = P[_HEAD : _HEAD + 9 * nb].reshape((nb, 3, 3))
     m = P[_HEAD + 18 * nb : _HEAD + 19 * nb]
     for e in range(Q.shape[0]):
         Q[e] = 0.0
-    w = np.empty(6)
     for f in range(terms.shape[0]):
         kernel, idx, off = terms[f, 0], terms[f, 2], terms[f, 3]
         p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]
@@ -1240,66 +1286,91 @@ def rigid_loads(t, g, V, terms, params, fdata, P, Q):  # type: ignore[no-untyped
     return 0
 
 
-@njit(cache=True)
-def tree_loads_rows_rigid(t, g, V, terms, params, fdata, cons, cparams, P, A, b, out):  # type: ignore[no-untyped-def]
-    """:func:`rigid_loads`, then :func:`tree_rows_rigid`: one call from the state to the
-    accelerations, for a System whose force models and constraints all have a compiled
-    form and whose loads all go through the solve. Returns 0, or the status of a kernel that
-    failed (then ``out`` is not written)."""
-    g, V, terms, params, fdata = (
-        borrowed(g),
-        borrowed(V),
-        borrowed(terms),
-        borrowed(params),
-        borrowed(fdata),
-    )
-    cons, cparams, P, A, b, out = (
-        borrowed(cons),
-        borrowed(cparams),
-        borrowed(P),
-        borrowed(A),
-        borrowed(b),
-        borrowed(out),
-    )
-    Q = np.empty(6 * V.shape[0])
-    status = rigid_loads(t, g, V, terms, params, fdata, P, Q)
-    if status != 0:
-        return status
-    return tree_rows_rigid(t, g, V, Q, cons, cparams, P, A, b, out)
+@njit(cache=True, inline="always")
+def one_call_tables(ints, floats):  # type: ignore[no-untyped-def]
+    """The tables of :func:`tree_state_rigid` from its two packed arrays (their layout is
+    :meth:`TreeSolver._one_call_tables`'s): (terms, cons, params, cparams, P)."""
+    nt, nc = ints[0], ints[1]
+    terms = ints[4 : 4 + 8 * nt].reshape((nt, 8))
+    cons = ints[4 + 8 * nt : 4 + 8 * nt + 6 * nc].reshape((nc, 6))
+    return terms, cons, floats[: ints[2]], floats[ints[2] : ints[3]], floats[ints[3] :]
 
 
 @njit(cache=True)
-def tree_state_rigid(t, g, V, terms, params, fdata, cons, cparams, P, out):  # type: ignore[no-untyped-def]
-    """:func:`tree_loads_rows_rigid` from a State's own read-only arrays, with the scratch
-    rows allocated here: writes ``out`` as :func:`tree_rigid` does (``out`` (4n + s + 3) sets
-    s) and returns 0 only when the call is solved and certified (status 0) and every entry
-    of ``out`` is finite, so that the caller need not scan them again; 1 otherwise (the
-    caller's general path then decides, and names what failed)."""
+def tree_state_rigid(t, g, V, ints, floats, fdata, out):  # type: ignore[no-untyped-def]
+    """The loads (:func:`rigid_loads`), the rows (:func:`constraint_block`) and the solve
+    (:func:`tree_rigid`) in one call, from a State's own read-only arrays g (n_b, 4, 4) and
+    V (n_b, 6) of any strides: for a System whose force models and constraints all have a
+    compiled form and whose loads all go through the solve. ``ints`` and ``floats`` pack the
+    force terms, the constraint table, the parameters and the tree (:func:`one_call_tables`),
+    ``fdata`` is the force models' field data. Writes ``out`` as :func:`tree_rigid` does
+    (``out`` (4n + s + 3) sets s) and returns 0 only when the call is solved and certified
+    (status 0) and every entry of ``out`` is finite, so that the caller need not scan them
+    again; 1 otherwise (the caller's general path then decides, and names what failed).
+
+    Allocates one float64 and one int64 work array, from which every other array is a
+    view (:func:`_tree_state`)."""
     nb = V.shape[0]
     s = out.shape[0] - 24 * nb - 3
-    A = np.zeros((s, 12))
-    b = np.empty(s)
-    if tree_loads_rows_rigid(
-        t, g.copy(), V.copy(), terms, params, fdata, cons, cparams, P, A, b, out
-    ) != 0 or out[-1] != 0.0:  # fmt: skip
+    n_float, n_int = tree_work_sizes(floats[ints[3] :])
+    work = np.empty(22 * nb + 13 * s + 6 + 6 * nb + 12 * nb + n_float)
+    return _tree_state(t, g, V, ints, floats, fdata, out, work, np.empty(n_int, np.int64))
+
+
+@njit(cache=True)
+def _tree_state(t, g, V, ints, floats, fdata, out, work, iwork):  # type: ignore[no-untyped-def]
+    """:func:`tree_state_rigid` with its work arrays, held by the caller."""
+    ints, floats, fdata, out = borrowed(ints), borrowed(floats), borrowed(fdata), borrowed(out)
+    work, iwork = borrowed(work), borrowed(iwork)
+    terms, cons, params, cparams, P = one_call_tables(ints, floats)
+    nb = V.shape[0]
+    s = out.shape[0] - 24 * nb - 3
+    gw = work[: 16 * nb].reshape((nb, 4, 4))  # writable C-contiguous copies: the kernels' types
+    Vw = work[16 * nb : 22 * nb].reshape((nb, 6))
+    for k in range(nb):
+        for u in range(4):
+            for e in range(4):
+                gw[k, u, e] = g[k, u, e]
+        for e in range(6):
+            Vw[k, e] = V[k, e]
+    o = 22 * nb
+    A = work[o : o + 12 * s].reshape((s, 12))
+    for e in range(12 * s):
+        work[o + e] = 0.0
+    b = work[o + 12 * s : o + 13 * s]
+    o += 13 * s
+    w = work[o : o + 6]
+    Q = work[o + 6 : o + 6 + 6 * nb]
+    o += 6 + 6 * nb
+    if rigid_loads(t, gw, Vw, terms, params, fdata, P, Q, w) != 0:
         return 1
+    if _blocks_of_rows(t, gw, Vw, cons, cparams, A, b) != 0:
+        return 1
+    _tree_rigid(gw, Vw, Q, A, b, P, out, work[o:], iwork)
+    if out[-1] != 0.0:
+        return 1
+    not_finite = False  # x − x is 0 for a finite x, NaN otherwise: no branch per entry
     for e in range(out.shape[0] - 1):
-        if not np.isfinite(out[e]):
-            return 1
-    return 0
+        not_finite |= out[e] - out[e] != 0.0
+    return 1 if not_finite else 0
 
 
 _I2 = types.Array(types.int64, 2, "C")
 _RO1 = types.Array(types.float64, 1, "C", readonly=True)
-_RO2 = types.Array(types.float64, 2, "C", readonly=True)
-_RO3 = types.Array(types.float64, 3, "C", readonly=True)
 #: The signature of :func:`tree_rows_rigid` as the System calls it.
 TREE_ROWS_SIGNATURE = types.int64(
     types.float64, _RW3, _RW2, _RW1, _I2, _RW1, _RW1, _RW2, _RW1, _RW1
 )
-#: The signature of :func:`tree_state_rigid` as the System calls it (a State's arrays).
+#: The signature of :func:`tree_state_rigid` as the System calls it: a State's read-only
+#: arrays, of any strides.
 TREE_STATE_SIGNATURE = types.int64(
-    types.float64, _RO3, _RO2, _I2, _RW1, _RO1, _I2, _RW1, _RW1, _RW1
+    types.float64,
+    types.Array(types.float64, 3, "A", readonly=True),
+    types.Array(types.float64, 2, "A", readonly=True),
+    types.Array(types.int64, 1, "C"),
+    _RW1,
+    _RO1,
+    _RW1,
 )
 _tree_rows_c: Any = None
 _tree_state_c: Any = None  # the entry of tree_state_rigid
@@ -1414,6 +1485,15 @@ class TreeSolver(UKSolver):
         self._V_shape = (lay.n_rigid, 6)
         self._zero_loads = system._zero_loads
         self._zero_z = system._zero_z
+        #: The fields of a one-call Accelerations that do not depend on the state.
+        self._shared = {
+            "layout": lay,
+            "extra": self._zero_loads,
+            "control_force": self._zero_loads,
+            "unmodeled_force": self._zero_loads,
+            "unreachable": 0.0,
+            "z_dot": self._zero_z,
+        }
         self._constraints = system.constraints
         self._rows_n: list[int] | None = None
         # the joints the solve eliminates with their child, as the articulated-body algorithm
@@ -1442,12 +1522,14 @@ class TreeSolver(UKSolver):
             _tree_rows_entry()
         # every load compiled and seen by the solve: loads, rows and solve in one call
         self._loads_table: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._one_call: tuple[Any, ...] | None = None  # _one_call_tables
         if self._cons is not None and not system._plant_only_loads and not system.controllers:
             from gmuk.engine.integrators import _program
 
             plan, in_python = _program.force_terms(system._force_plan)
             if not in_python and all(term[3] for term in plan):  # rigid bodies only
                 self._loads_table = _program.pack_terms(plan)
+                self._one_call_tables()
                 _tree_state_entry()
         from gmuk.engine.system import _pair
 
@@ -1461,13 +1543,37 @@ class TreeSolver(UKSolver):
             s._J, s._Jinv, s._m_rigid, self._order, self._parent, self._pairs, rows,
             s.consistency_tol, s._singular, self._subspaces,
         )  # fmt: skip
+        if getattr(self, "_loads_table", None) is not None:
+            self._one_call_tables()
+
+    def _one_call_tables(self) -> None:
+        """The tables of :func:`tree_state_rigid` packed into two arrays (fewer arguments to
+        convert at each call): ``ints`` = [n_terms, n_constraints, end of the force
+        parameters, end of the constraint parameters, the force terms (n_terms, 8) row by
+        row, the constraint table (n_c, 6) row by row] and ``floats`` = [force parameters,
+        constraint parameters, the packed tree P]; the field data stays read-only beside
+        them."""
+        assert self._loads_table is not None and self._cons is not None
+        terms, params, fdata = self._loads_table
+        head = [terms.shape[0], self._cons.shape[0], params.size, params.size + self._cparams.size]
+        n, s = self._n, self._s
+        self._one_call = (
+            np.concatenate([np.array(head), terms.ravel(), self._cons.ravel()]).astype(np.int64),
+            np.concatenate([params, self._cparams, self._P]),
+            fdata,
+            4 * n + s + 3,  # the size of the call's output
+            n,
+            s,
+            self._shared,
+        )
 
     def loop_constants(self, state: State) -> np.ndarray:
         """The packed tree (:func:`tree_params`) after its first two entries, which the
         compiled program puts in front (``solve_constants`` of
         :class:`gmuk.engine.integrators._program.SystemView`), with each constraint's row
         count as it is at ``state``."""
-        self._blocks(state)  # packs the row counts of constraints evaluated in Python
+        if self._cons is None:  # packs the row counts of constraints evaluated in Python
+            self._blocks(state)
         return np.array(self._P[2:])
 
     @classmethod
@@ -1537,22 +1643,14 @@ class TreeSolver(UKSolver):
         """One compiled call (free acceleration, tree solve, wrenches) when nothing acts on
         the plant beyond the solve, with the loads in it too when every force model is
         compiled; the general path otherwise."""
-        system = self.system
-        if self._loads_table is not None and self._cons is not None:
-            terms, params, fdata = self._loads_table
-            s, n = self._s, self._n
-            out = np.empty(4 * n + s + 3)
-            g, V = state.g, state.V  # a State's own float64 arrays: C-contiguous unless built so
-            if (
-                g.flags.c_contiguous
-                and V.flags.c_contiguous
-                and _tree_state_c(
-                    float(state.t), g, V, terms, params, fdata, self._cons, self._cparams,
-                    self._P, out,
-                ) == 0
-            ):  # fmt: skip
-                return self._solved(out, s, self._zero_loads, finite=True)
+        one = self._one_call
+        if one is not None:  # one compiled call from the State's own arrays
+            ints, floats, fdata, size, n, s, shared = one
+            out = np.empty(size)
+            if _tree_state_c(float(state.t), state.g, state.V, ints, floats, fdata, out) == 0:
+                return _packed(out, n, s, shared)
             # a kernel failed or the call is not certified: the path below decides
+        system = self.system
         modeled, unmodeled = self._loads(state)
         if system._plant_only_loads:
             return self._general(state, modeled, unmodeled, None)
@@ -1595,16 +1693,12 @@ class TreeSolver(UKSolver):
             self._not_finite(state)
         return self._general(state, modeled, unmodeled, _Blocks(A, b))
 
-    def _solved(
-        self, out: FloatArray, s: int, unmodeled: FloatArray, finite: bool = False
-    ) -> Accelerations:
+    def _solved(self, out: FloatArray, s: int, unmodeled: FloatArray) -> Accelerations:
         """The Accelerations of a certified compiled call (``out`` as :func:`tree_rigid`
-        writes it); ``finite``: the call has checked that every entry of ``out`` is finite
-        (``Accelerations._finite_checked``)."""
+        writes it)."""
         n = self._n
         return Accelerations._from_dict(
             {
-                "_finite_checked": finite,
                 "layout": self._lay,
                 "free": out[:n],
                 "constraint": out[n : 2 * n],

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from gmuk._numba import njit
+from gmuk._numba import borrowed, njit
 from gmuk.lie._coeffs import _C_SERIES, _D_SERIES, _DE_SERIES_BELOW, _E_SERIES, _SERIES_BELOW
 
 _C = tuple(float(c) for c in _C_SERIES)  # highest power first (np.polyval order)
@@ -24,6 +24,26 @@ _D = tuple(float(c) for c in _D_SERIES)
 _E = tuple(float(c) for c in _E_SERIES)
 _T = float(_SERIES_BELOW)
 _TDE = float(_DE_SERIES_BELOW)
+#: Below this x = θ² (θ ≤ 0.5 rad, the angles of an integrator's stage increments) the
+#: series are summed with fewer terms (:func:`_leading_terms`).
+_SHORT_BELOW = 0.25
+
+
+def _leading_terms(coeffs: tuple[float, ...], x_max: float) -> tuple[float, ...]:
+    """The lowest-power coefficients of a series in x (``coeffs`` highest power first)
+    whose dropped terms sum, for 0 ≤ x ≤ x_max, to less than 2⁻⁵⁶ of the series' smallest
+    value there (|c₀| less every other term at x_max): below a quarter of the last bit."""
+    c = coeffs[::-1]
+    low = abs(c[0]) - sum(abs(v) * x_max**k for k, v in enumerate(c) if k)
+    for keep in range(1, len(c) + 1):
+        if sum(abs(v) * x_max**k for k, v in enumerate(c) if k >= keep) < 2.0**-56 * low:
+            return coeffs[len(c) - keep :]
+    return coeffs
+
+
+_C_SHORT = _leading_terms(_C, _SHORT_BELOW)
+_D_SHORT = _leading_terms(_D, _SHORT_BELOW)
+_E_SHORT = _leading_terms(_E, _SHORT_BELOW)
 
 
 @njit(cache=True, inline="always")
@@ -32,6 +52,13 @@ def _horner(coeffs: tuple, x: float) -> float:
     for c in coeffs:
         acc = acc * x + c
     return acc
+
+
+@njit(cache=True, inline="always")
+def _series(coeffs: tuple, short: tuple, x: float) -> float:
+    """The series ``coeffs`` at x, with its leading terms ``short`` only where the rest is
+    below the last bit (x ≤ :data:`_SHORT_BELOW`)."""
+    return _horner(short, x) if x <= _SHORT_BELOW else _horner(coeffs, x)
 
 
 @njit(cache=True)
@@ -50,7 +77,7 @@ def _b(t: float) -> float:
 def _c(t: float) -> float:
     """(θ − sin θ)/θ³."""
     if t < _T:
-        return _horner(_C, t * t)
+        return _series(_C, _C_SHORT, t * t)
     return (t - math.sin(t)) / (t * t * t)
 
 
@@ -58,7 +85,7 @@ def _c(t: float) -> float:
 def _d(t: float) -> float:
     """(1 − (θ/2) cot(θ/2))/θ²."""
     if t < _TDE:
-        return _horner(_D, t * t)
+        return _series(_D, _D_SHORT, t * t)
     h = 0.5 * t
     return (1.0 - h / math.tan(h)) / (t * t)
 
@@ -67,7 +94,7 @@ def _d(t: float) -> float:
 def _f1_f2(t: float) -> tuple[float, float]:
     d = _d(t)
     if t < _TDE:
-        e = _horner(_E, t * t)
+        e = _series(_E, _E_SHORT, t * t)
     else:
         e = (d - 1.0 / 12.0) / (t * t)
     return 2.5 * d - 0.5 * t * t * d * d - 0.125, 1.5 * e - 0.5 * d * d
@@ -165,6 +192,7 @@ def so3_log(R: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def _se3_exp(xi: np.ndarray, g: np.ndarray) -> None:
+    g = borrowed(g)  # the caller holds it: its view below counts no references
     w0, w1, w2 = xi[0], xi[1], xi[2]
     r0, r1, r2 = xi[3], xi[4], xi[5]
     t = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
@@ -199,6 +227,7 @@ def se3_exp(xi: np.ndarray) -> np.ndarray:
 @njit(cache=True)
 def _compose_exp_into(G0: np.ndarray, xi: np.ndarray, out: np.ndarray) -> None:
     """:func:`compose_exp` written into ``out``."""
+    G0, xi, out = borrowed(G0), borrowed(xi), borrowed(out)  # the caller holds them
     n = xi.shape[0]
     E = np.empty((4, 4))
     for k in range(n):
@@ -247,31 +276,33 @@ def se3_log(g: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
-def _ad_apply(xi: np.ndarray, W: np.ndarray, out: np.ndarray) -> None:
-    """out = ad_ξ W = [θ × ω_W; ρ × ω_W + θ × v_W]."""
+def _ad_tuple(xi, W):  # type: ignore[no-untyped-def]
+    """:func:`_ad_apply` on 6-tuples: ad_ξ W = [θ × ω_W; ρ × ω_W + θ × v_W] (6-tuple)."""
     a0, a1, a2 = _cross(xi[0], xi[1], xi[2], W[0], W[1], W[2])
     b0, b1, b2 = _cross(xi[3], xi[4], xi[5], W[0], W[1], W[2])
     c0, c1, c2 = _cross(xi[0], xi[1], xi[2], W[3], W[4], W[5])
-    out[0], out[1], out[2] = a0, a1, a2
-    out[3], out[4], out[5] = b0 + c0, b1 + c1, b2 + c2
+    return a0, a1, a2, b0 + c0, b1 + c1, b2 + c2
+
+
+@njit(cache=True, inline="always")
+def _ad_apply(xi: np.ndarray, W: np.ndarray, out: np.ndarray) -> None:
+    """out = ad_ξ W = [θ × ω_W; ρ × ω_W + θ × v_W] (:func:`_ad_tuple`)."""
+    r = _ad_tuple((xi[0], xi[1], xi[2], xi[3], xi[4], xi[5]), (W[0], W[1], W[2], W[3], W[4], W[5]))
+    out[0], out[1], out[2], out[3], out[4], out[5] = r
 
 
 @njit(cache=True)
 def _dexp_inv_apply_into(xi: np.ndarray, V: np.ndarray, out: np.ndarray) -> None:
     """:func:`dexp_inv_apply` written into ``out``."""
+    xi, V, out = borrowed(xi), borrowed(V), borrowed(out)  # the caller holds them
     n = xi.shape[0]
-    w1 = np.empty(6)
-    w2 = np.empty(6)
-    w3 = np.empty(6)
-    w4 = np.empty(6)
     for k in range(n):
-        x = xi[k]
+        x = (xi[k, 0], xi[k, 1], xi[k, 2], xi[k, 3], xi[k, 4], xi[k, 5])
         t = math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2])
         f1, f2 = _f1_f2(t)
-        _ad_apply(x, V[k], w1)
-        _ad_apply(x, w1, w2)
-        _ad_apply(x, w2, w3)
-        _ad_apply(x, w3, w4)
+        w1 = _ad_tuple(x, (V[k, 0], V[k, 1], V[k, 2], V[k, 3], V[k, 4], V[k, 5]))
+        w2 = _ad_tuple(x, w1)
+        w4 = _ad_tuple(x, _ad_tuple(x, w2))
         for i in range(6):
             out[k, i] = V[k, i] + 0.5 * w1[i] + f1 * w2[i] + f2 * w4[i]
 

@@ -580,19 +580,26 @@ class Joint(Constraint):
             np.ascontiguousarray(Ad_CJ @ self.motion_subspace),
         )
 
-    def _violation_along(self, states: Sequence[State]) -> tuple[FloatArray, FloatArray] | None:
+    def _violation_along(
+        self,
+        states: Sequence[State],
+        stacked: tuple[FloatArray, FloatArray] | None = None,
+    ) -> tuple[FloatArray, FloatArray] | None:
         """:meth:`violation` at each of ``states`` (one System's), (N, s) each, in one compiled
         loop (the drift check of a run evaluates up to 65 outputs); None for a subclass with
-        its own ``violation``."""
+        its own ``violation``. ``stacked``: the states' poses (N, n_rigid, 4, 4) and twists
+        (N, n_rigid, 6), when the caller has them (else stacked here)."""
         if type(self).violation is not Joint.violation or not states:
             return None
-        layout = states[0].layout
-        if any(st.layout is not layout and st.layout != layout for st in states):
-            return None
+        if stacked is None:  # (stacked from one trajectory, they share its layout)
+            layout = states[0].layout
+            if any(st.layout is not layout and st.layout != layout for st in states):
+                return None
+            stacked = (np.array([st.g for st in states]), np.array([st.V for st in states]))
         idx = self._rigid_indices(states[0])
         i, j = (idx[0], idx[0]) if self.grounded else idx
-        g = np.array([st.g for st in states], dtype=float)
-        V = np.array([st.V for st in states], dtype=float)
+        g = np.asarray(stacked[0], dtype=float)
+        V = np.asarray(stacked[1], dtype=float)
         s = self._T.shape[0]
         pos, vel = np.empty((len(states), s)), np.empty((len(states), s))
         _residuals_along(

@@ -96,19 +96,21 @@ def test_compiled_loads_give_the_python_loads_numbers_bit_for_bit(name):
     damping here) keeps the loads in Python."""
     robot = _robot(name, solver="tree")
     solver = robot.system.solver
-    table = solver._loads_table
-    assert table is not None
-    assert _robot(name, solver="tree", damping=0.7).system.solver._loads_table is None
+    one_call = solver._one_call
+    assert one_call is not None and solver._loads_table is not None
+    assert _robot(name, solver="tree", damping=0.7).system.solver._one_call is None
     rng = np.random.default_rng(31)
     for _ in range(5):
         q, v = _random_qv(robot.model, rng)
         state = robot.state(q, v)
         fast = robot.system.accelerations(state)
-        solver._loads_table = None
+        assert fast._finite_checked  # the one call answered
+        solver._one_call = None
         try:
             python_loads = robot.system.accelerations(state)
         finally:
-            solver._loads_table = table
+            solver._one_call = one_call
+        assert not python_loads._finite_checked
         general = solver._general(state, *solver._loads(state), None)
         for field in FIELDS:
             np.testing.assert_array_equal(getattr(fast, field), getattr(python_loads, field))
@@ -515,3 +517,66 @@ def test_the_one_call_path_never_returns_an_acceleration_that_overflowed():
     )
     acc = light.accelerations(light.state(g={"link": np.eye(4)}, V={"link": np.zeros(6)}))
     assert acc._finite_checked and np.all(np.isfinite(acc.total))
+
+
+def test_a_one_call_accelerations_reads_like_any_other():
+    """The one compiled call hands back its output array, and the Accelerations makes each
+    field the first time it is read: every field, ``of``, ``repr``, ``dataclasses.replace``
+    and pickling behave as for the general path's, and a name that is not a field is an
+    AttributeError."""
+    import dataclasses
+    import pickle
+
+    robot = _robot("panda", solver="tree")
+    q, v = _random_qv(robot.model, np.random.default_rng(5))
+    state = robot.state(q, v)
+    fast = robot.system.accelerations(state)
+    general = robot.system.solver._general(state, *robot.system.solver._loads(state), None)
+    assert fast._finite_checked and not general._finite_checked
+    for f in dataclasses.fields(general):
+        got, expected = getattr(fast, f.name), getattr(general, f.name)
+        if isinstance(expected, np.ndarray):
+            assert got.shape == expected.shape, f.name
+            assert _relative(got, expected) <= RTOL, f.name
+        elif f.name == "residual":
+            assert got <= 1e-9 * max(1.0, float(np.abs(fast.total).max()))
+        else:
+            assert got == expected, f.name
+    link = robot.system.layout.names[0]
+    np.testing.assert_array_equal(fast.of(link, "constraint_force"), fast.constraint_force[:6])
+    assert "total=" in repr(fast)
+    back = pickle.loads(pickle.dumps(fast))
+    np.testing.assert_array_equal(back.total, fast.total)
+    assert back.rank == fast.rank == fast.multipliers.size
+    moved = dataclasses.replace(fast, total=np.zeros_like(fast.total))
+    assert not moved.total.any() and moved.free is not None
+    with pytest.raises(AttributeError, match="no attribute 'totl'"):
+        fast.totl
+    import copy
+
+    np.testing.assert_array_equal(copy.deepcopy(fast).multipliers, fast.multipliers)
+
+
+def test_the_one_call_path_takes_state_arrays_of_any_strides():
+    """A State may share read-only arrays that are not C-contiguous (views of another
+    array): the one compiled call reads them through their strides, with the same numbers
+    as from contiguous copies."""
+    robot = _robot("ur5", solver="tree")
+    q, v = _random_qv(robot.model, np.random.default_rng(8))
+    state = robot.state(q, v)
+    n = state.g.shape[0]
+    g_wide = np.zeros((n, 4, 8))
+    g_wide[:, :, ::2] = state.g
+    V_wide = np.zeros((n, 12))
+    V_wide[:, ::2] = state.V
+    for a in (g_wide, V_wide):
+        a.setflags(write=False)
+    strided = state.replace(g=g_wide[:, :, ::2], V=V_wide[:, ::2])
+    assert not strided.g.flags.c_contiguous and not strided.V.flags.c_contiguous
+    assert np.shares_memory(strided.g, g_wide)  # shared, not copied into C order
+    fast = robot.system.accelerations(strided)
+    assert fast._finite_checked
+    for field in FIELDS:
+        np.testing.assert_array_equal(
+            getattr(fast, field), getattr(robot.system.accelerations(state), field)
+        )

@@ -54,7 +54,7 @@ from numba.extending import intrinsic
 
 from gmuk._numba import borrowed, kernel_address, kernel_caller, njit
 from gmuk.control.base import CONTROL_KERNEL
-from gmuk.dynamics import rigid_free_accel
+from gmuk.dynamics import rigid_free_accel_into
 from gmuk.engine._uk_kernels import _qr_solve, uk_rigid
 from gmuk.engine.integrators import _dop853_tableau as _tab
 from gmuk.engine.integrators._program import (
@@ -69,12 +69,13 @@ from gmuk.engine.integrators._program import (
 )
 from gmuk.engine.tree import (
     TREE,
+    _tree_solve,
     body_rhs,
     constraint_block,
     kernel_rows,
     singular_at,
     tree_pair,
-    tree_solve,
+    tree_work_sizes,
 )
 from gmuk.forces.base import FORCE_KERNEL
 from gmuk.lie._kernels import _compose_exp_into, _dexp_inv_apply_into
@@ -202,18 +203,77 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
     acceleration, constraint wrenches M ν̇_c, multipliers λ, the solve's residual, the
     controllers' generalized forces, their states' rates ż, the rank of A). Returns a
     :class:`Status`: DONE, NONFINITE, CALLBACK, or FIELD with the failed kernel's status in
-    ``ints[I_FIELD]``."""
+    ``ints[I_FIELD]``.
+
+    Allocates the evaluation's work arrays, one float64 and one int64
+    (:func:`_work_sizes`), and holds them for :func:`_evaluate`."""
+    parts = borrowed(parts)  # the caller holds it: the calls below count none of its arrays
+    n_float, n_int = _work_sizes(parts)
+    return _evaluate(
+        t, Y, G0, parts, dY, aux, ints, np.empty(n_float), np.empty(n_int, dtype=np.int64)
+    )
+
+
+@_helper
+def _work_sizes(parts):  # type: ignore[no-untyped-def]
+    """The sizes of :func:`_evaluate`'s float64 and int64 work arrays: the poses, the loads,
+    the rows, the free accelerations, the fused solve's outputs and the tree solve's work."""
+    d = parts.dims
+    nr, ndof, s = d.n_rigid, d.n_dof, d.n_rows
+    tree_float, tree_int = 0, 0
+    if s and d.solve == TREE:
+        tree_float, tree_int = tree_work_sizes(parts.uk_params)
+    n_float = (
+        16 * nr + 2 * ndof + 6 + 31  # g, modeled, the body's rhs, w, a point mass's pose
+        + s * (1 + max(12, ndof)) + 4 * ndof + s + 3  # b, A, the fused solve's out
+        + 12 * nr + 12  # Q and the free accelerations, u and ż of a controller
+        + tree_float
+    )  # fmt: skip
+    return n_float, tree_int
+
+
+@_helper
+def _evaluate(t, Y, G0, parts, dY, aux, ints, work, iwork):  # type: ignore[no-untyped-def]
+    """:func:`rhs` with its work arrays, from which every array of the evaluation is a
+    view."""
     d = parts.dims
     # borrowed references (gmuk._numba.borrowed): the caller holds the arguments for the
     # call, and the views taken of them below then count no references
     Y, G0, dY, aux, ints = borrowed(Y), borrowed(G0), borrowed(dY), borrowed(aux), borrowed(ints)
+    work, iwork = borrowed(work), borrowed(iwork)
     terms, params = borrowed(parts.terms), borrowed(parts.params)
     fdata = borrowed(parts.field_data)
     J, Jinv = borrowed(parts.J), borrowed(parts.Jinv)
     m_r, m_e = borrowed(parts.m_rigid), borrowed(parts.m_euclid)
     r_off, e_off = borrowed(parts.rigid_offsets), borrowed(parts.euclid_offsets)
     io = borrowed(parts.io)
+    cons, cparams, P = borrowed(parts.cons), borrowed(parts.cparams), borrowed(parts.uk_params)
     nr, ne, ndof, s, nc = d.n_rigid, d.n_euclid, d.n_dof, d.n_rows, d.n_control
+    # the work arrays, in the order of _work_sizes
+    g = work[: 16 * nr].reshape((nr, 4, 4))
+    o = 16 * nr
+    modeled = work[o : o + ndof]
+    r_body = work[o + ndof : o + 2 * ndof]  # body_rhs where a mass block is singular
+    w = work[o + 2 * ndof : o + 2 * ndof + 6]
+    o += 2 * ndof + 6
+    gp = work[o : o + 16].reshape((4, 4))
+    vp = work[o + 16 : o + 22]
+    no_inertia = work[o + 22 : o + 31].reshape((3, 3))
+    o += 31
+    b = work[o : o + s]
+    o += s
+    A = work[o : o + s * (12 if d.solve == TREE else ndof)].reshape(
+        (s, 12 if d.solve == TREE else ndof)
+    )
+    o += s * max(12, ndof)
+    out = work[o : o + 4 * ndof + s + 3]
+    o += 4 * ndof + s + 3
+    Q = work[o : o + 6 * nr].reshape((nr, 6))
+    a_r = work[o + 6 * nr : o + 12 * nr].reshape((nr, 6))
+    o += 12 * nr
+    u = work[o : o + 6]
+    zd = work[o + 6 : o + 12]
+    tree_work = work[o + 12 :]
     total = aux[:ndof]
     # views of Y, not copies: nothing is allocated per evaluation that a view can replace
     xi = Y[: 6 * nr].reshape((nr, 6))
@@ -223,7 +283,6 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
         if Y[i] != 0.0:
             any_xi = True
             break
-    g = np.empty((nr, 4, 4))
     if nr:
         _compose_exp_into(G0, xi, g)
     x0 = 12 * nr
@@ -238,18 +297,16 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
         # the loads on the plant (in this function, not a helper inlined into it: numba's
         # inlining copies and retypes the helper's IR at each compilation)
         unmodeled = aux[ndof : 2 * ndof]
-        modeled = np.zeros(ndof)
         for i in range(ndof):
+            modeled[i] = 0.0
             unmodeled[i] = 0.0
-        w = np.empty(6)
         if d.point_terms:  # a point mass's pose and velocity, as its force kernels take them
-            gp = np.zeros((4, 4))
-            vp = np.zeros(6)
-            no_inertia = np.zeros((3, 3))
-        else:
-            gp = np.empty((0, 0))
-            vp = np.empty(0)
-            no_inertia = gp
+            for i in range(16):
+                gp[i // 4, i % 4] = 0.0
+            for i in range(6):
+                vp[i] = 0.0
+            for i in range(9):
+                no_inertia[i // 3, i % 3] = 0.0
         for f in range(terms.shape[0]):
             kernel, rig, idx, off = terms[f, 0], terms[f, 1], terms[f, 2], terms[f, 3]
             p0, f0, f1 = terms[f, 5], terms[f, 6], terms[f, 7]
@@ -286,23 +343,20 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
                 unmodeled[i] += io[lo + ndof + i]
         rank_at = 5 * ndof + s + 1 + nc
         if s:  # the stacked rows: (s, n_dof) for the fused or the dense solve, blocks (s, 12)
-            b = np.empty(s)  # on each constraint's one or two bodies for the tree solve
+            for i in range(s):  # on each constraint's one or two bodies for the tree solve
+                for e in range(A.shape[1]):
+                    A[i, e] = 0.0
             if d.solve == TREE:
-                A = np.zeros((s, 12))
-                status = _constraint_blocks(
-                    t, g, V, parts.cons, parts.cparams, io, r_off, parts.uk_params, A, b
-                )
+                status = _constraint_blocks(t, g, V, cons, cparams, io, r_off, P, A, b)
             else:
-                A = np.zeros((s, ndof))
-                status = _constraint_rows(t, g, V, parts.cons, parts.cparams, io, r_off, A, b)
+                status = _constraint_rows(t, g, V, cons, cparams, io, r_off, A, b)
             if status != 0:
                 ints[I_FIELD] = status
                 _write_state(t, g, V, Y, d, io)
                 return FIELD
         if s and d.solve == FUSED:
             # rigid bodies only, every load seen by the solve: one compiled call
-            out = np.empty(4 * ndof + s + 3)
-            uk_rigid(V, modeled, A, b, parts.uk_params, out)
+            uk_rigid(V, modeled, A, b, P, out)
             if out[4 * ndof + s + 2] != 0.0:  # not certified: the Python solve decides
                 if not written:
                     _write_state(t, g, V, Y, d, io)
@@ -319,11 +373,10 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
         else:
             # ν̇_a = M⁻¹(ad*_V 𝕀V + Q): Eq. 10b for rigid bodies, Q/m for point masses
             if nr:
-                Q = np.empty((nr, 6))
                 for k in range(nr):
                     for i in range(6):
                         Q[k, i] = modeled[r_off[k] + i]
-                a_r = rigid_free_accel(V, J, Jinv, m_r, Q)
+                rigid_free_accel_into(V, J, Jinv, m_r, Q, a_r)
                 for k in range(nr):
                     for i in range(6):
                         total[r_off[k] + i] = a_r[k, i]
@@ -335,14 +388,22 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
             if s:  # the dense strategy's certified QR solve (DenseSolver.solve_rows), or
                 # the tree strategy's certified block LDLᵀ (TreeSolver.solve)
                 ac = aux[2 * ndof : 3 * ndof]
-                P = parts.uk_params
-                rhs = np.zeros(0)
+                singular = False
                 if d.solve == TREE:
-                    if P[singular_at(P)] != 0.0:  # bodies with a singular mass block
-                        rhs = np.empty(ndof)
-                        body_rhs(V, modeled, total, P, rhs)
-                    residual, scale, status = tree_solve(
-                        g, total, rhs, A, b, P, ac, aux[4 * ndof : 4 * ndof + s]
+                    singular = P[singular_at(P)] != 0.0
+                    if singular:  # bodies with a singular mass block
+                        body_rhs(V, modeled, total, P, r_body)
+                    residual, scale, status = _tree_solve(
+                        g,
+                        total,
+                        r_body,
+                        A,
+                        b,
+                        P,
+                        ac,
+                        aux[4 * ndof : 4 * ndof + s],
+                        tree_work,
+                        iwork,
                     )
                 else:
                     Minv_sqrt = P[2 : 2 + ndof * ndof].reshape((ndof, ndof))
@@ -357,8 +418,9 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
                     aux[4 * ndof + s] = residual
                     aux[rank_at] = s
                     _apply_M(ac, J, m_r, m_e, r_off, e_off, aux[3 * ndof : 4 * ndof])
-                    for i in range(rhs.shape[0]):  # Aᵀλ = M ν̇_c − r
-                        aux[3 * ndof + i] -= rhs[i]
+                    if singular:  # Aᵀλ = M ν̇_c − r
+                        for i in range(ndof):
+                            aux[3 * ndof + i] -= r_body[i]
                     for i in range(ndof):
                         total[i] += ac[i]
         if not in_python:  # the controllers and the loads on the plant
@@ -377,8 +439,6 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
                     z_dot[i] = io[ca + 2 * ndof + i]
             ctrls, ctrl_params = parts.ctrls, parts.ctrl_params
             if ctrls.shape[0]:  # the compiled controllers (their kernels' addresses in ctrls)
-                u = np.empty(6)
-                zd = np.empty(6)
                 zs = x0 + 2 * ne
                 for c in range(ctrls.shape[0]):
                     kernel, k, o = ctrls[c, 0], ctrls[c, 1], ctrls[c, 2]
@@ -425,13 +485,14 @@ def rhs(t, Y, G0, parts, dY, aux, ints):  # type: ignore[no-untyped-def]
         dY[x0 + ne + i] = total[e_off[i]]
     for i in range(nc):
         dY[x0 + 2 * ne + i] = z_dot[i]
+    # every entry finite, the outputs too (forces, multipliers, the residual): x − x is 0
+    # for a finite x and NaN otherwise, so that the test needs no branch per entry
+    not_finite = False
     for i in range(dY.shape[0]):
-        if not math.isfinite(dY[i]):
-            return NONFINITE
-    for i in range(aux.shape[0]):  # the outputs too: forces, multipliers, the residual
-        if not math.isfinite(aux[i]):
-            return NONFINITE
-    return DONE
+        not_finite |= dY[i] - dY[i] != 0.0
+    for i in range(aux.shape[0]):
+        not_finite |= aux[i] - aux[i] != 0.0
+    return NONFINITE if not_finite else DONE
 
 
 @_helper
@@ -565,12 +626,18 @@ def _interpolate(F, Y0, s, out):  # type: ignore[no-untyped-def]
 
 @_helper
 def _stage_state(Y, h, a, K, i, out):  # type: ignore[no-untyped-def]
-    """out = Y + h Σ_{m<i} a_m K_m: the state at which stage i is evaluated."""
-    for j in range(Y.shape[0]):
-        q = 0.0
-        for m in range(i):
-            q += a[m] * K[m, j]
-        out[j] = Y[j] + h * q
+    """out = Y + h Σ_{m<i} a_m K_m: the state at which stage i is evaluated (the sum over m
+    in the outer loop, so that the inner one runs along K's rows; the same additions, in the
+    same order, for each entry)."""
+    n = Y.shape[0]
+    for j in range(n):
+        out[j] = 0.0
+    for m in range(i):
+        am = a[m]
+        for j in range(n):
+            out[j] += am * K[m, j]
+    for j in range(n):
+        out[j] = Y[j] + h * out[j]
 
 
 @_helper
@@ -840,6 +907,9 @@ def advance(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux
     the last accepted step), aux (its other outputs), fs and ints are updated in place to
     the last accepted step; outputs are appended to the buffers (times bt, states bY, base
     poses bG, rhs outputs baux) from ints[I_WRITTEN]."""
+    # borrowed references (gmuk._numba.borrowed): the caller holds the arguments, and each
+    # call below would otherwise count every array of the records on entry and on exit
+    parts, m = borrowed(parts), borrowed(m)
     if ints[I_STARTED] == 0:
         status = _start(parts, m, fs, ints, Y, G0, f0, aux, outs, has_outs, bt, bY, bG, baux)
         if status != DONE:
