@@ -6,8 +6,9 @@ Three measurements, each side by side in the same run, for gmuk's solve strategi
 (the tree solve, :mod:`gmuk.engine.tree`, and the dense fused one it replaces on trees):
 
 1. one ``robot.system.accelerations(state)`` call against one ``pin.aba`` call (C++, through
-   its Python binding) on the Panda (fingers locked), Solo12 (floating base) and UR5: medians
-   and ratios;
+   its Python binding) on the Panda (fingers locked), Solo12 (floating base) and UR5, timed in
+   turn round by round (``--repeat`` rounds, each the median of three loops): medians, and the
+   median of the rounds' ratios;
 2. a 1 s Panda run from a random state at rtol = atol = 1e-10: gmuk's ``simulate`` against
    Pinocchio's ABA driven by scipy's DOP853 at the same tolerances, with each one's error
    against a reference at 1e-13 (Pinocchio + DOP853), and the time per evaluation;
@@ -65,14 +66,19 @@ def one_call(repeat: int) -> None:
             v, tau = rng.normal(size=model.nv), np.zeros(model.nv)
             state = robot.state(q, v)
             robot.system.accelerations(state)
-            t_g = _median_s(lambda r=robot, s=state: r.system.accelerations(s), repeat, 50)
-            t_p = _median_s(
-                lambda m=model, d=data, q=q, v=v, u=tau: pin.aba(m, d, q, v, u), repeat, 2000
-            )
+            inner = 2000 if solver == "tree" else 50
+            t_gs, t_ps = [], []
+            for _ in range(repeat):  # in turn, round by round: the same load on both
+                t_ps.append(_median_s(
+                    lambda m=model, d=data, q=q, v=v, u=tau: pin.aba(m, d, q, v, u), 3, 2000
+                ))  # fmt: skip
+                t_gs.append(_median_s(lambda r=robot, s=state: r.system.accelerations(s), 3, inner))
+            t_g, t_p = statistics.median(t_gs), statistics.median(t_ps)
+            ratio = statistics.median([a / b for a, b in zip(t_gs, t_ps, strict=True)])
             rows = sum(j._T.shape[0] for j in robot.joints.values())
             print(f"  {name:7s} nv={model.nv:2d} rows={rows:3d} {solver:5s}: gmuk "
                   f"{t_g * 1e6:8.1f} µs, pin.aba {t_p * 1e6:6.2f} µs, "
-                  f"ratio {t_g / t_p:7.1f}")  # fmt: skip
+                  f"ratio {ratio:7.2f} (median of the rounds' ratios)")  # fmt: skip
 
 
 def panda_run(repeat: int) -> None:

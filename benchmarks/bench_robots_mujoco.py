@@ -163,7 +163,7 @@ def one_call(robot: Robot, repeat: int) -> None:
     robot.system.accelerations(state)
     med = _medians_s(
         {
-            "gmuk": (lambda: robot.system.accelerations(state), 50),
+            "gmuk": (lambda: robot.system.accelerations(state), 2000),
             "mujoco": (lambda: mujoco.mj_forward(m, d), 2000),
             "pin": (lambda: pin.aba(model, pin_data, q, v, tau), 2000),
         },
