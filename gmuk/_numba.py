@@ -336,6 +336,14 @@ def entry(kernel: Any) -> Any:
     return kernel
 
 
+def overload_entry(kernel: Any, signature: Any) -> Any:
+    """The compiled function of ``kernel``'s overload for ``signature``, callable without
+    dispatch: compiled now (or loaded from numba's cache) unless it exists already. The
+    dispatcher stays open to other types (unlike :func:`compiled_entry`)."""
+    kernel.compile(signature)  # the existing overload when there is one
+    return kernel.overloads[signature.args].entry_point
+
+
 def compiled_entry(kernel: Any, signature: Any) -> Any:
     """Compile ``kernel`` (a dispatcher made without a signature) for ``signature`` only — or
     load it from numba's cache — close it to further compilation, as a signature given to

@@ -45,6 +45,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
+from gmuk._numba import overload_entry
 from gmuk._validation import FloatArray, all_finite
 from gmuk.bodies import Body, RigidBody
 from gmuk.constraints.tangent_bundle import TangentBundleConstraint
@@ -101,9 +102,7 @@ def _fused_entry() -> Any:
     """
     global _uk_rigid_c
     if _uk_rigid_c is None:
-        kernel, sig = _uk_kernels.uk_rigid, _uk_kernels.UK_RIGID_SIGNATURE
-        kernel.compile(sig)  # the existing overload if the loop compiled it first
-        _uk_rigid_c = kernel.overloads[sig.args].entry_point
+        _uk_rigid_c = overload_entry(_uk_kernels.uk_rigid, _uk_kernels.UK_RIGID_SIGNATURE)
     return _uk_rigid_c
 
 

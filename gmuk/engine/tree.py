@@ -65,7 +65,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numba import types
 
-from gmuk._numba import borrowed, kernel_address, kernel_caller, njit
+from gmuk._numba import borrowed, kernel_address, kernel_caller, njit, overload_entry
 from gmuk._validation import FloatArray, all_finite
 from gmuk.bodies import BodyKind
 from gmuk.constraints.base import ROWS_KERNEL, as_rows
@@ -1380,8 +1380,7 @@ def _tree_state_entry() -> Any:
     """The compiled entry of :func:`tree_state_rigid` for :data:`TREE_STATE_SIGNATURE`."""
     global _tree_state_c
     if _tree_state_c is None:
-        tree_state_rigid.compile(TREE_STATE_SIGNATURE)
-        _tree_state_c = tree_state_rigid.overloads[TREE_STATE_SIGNATURE.args].entry_point
+        _tree_state_c = overload_entry(tree_state_rigid, TREE_STATE_SIGNATURE)
     return _tree_state_c
 
 
@@ -1389,8 +1388,7 @@ def _tree_rows_entry() -> Any:
     """The compiled entry of :func:`tree_rows_rigid` for :data:`TREE_ROWS_SIGNATURE`."""
     global _tree_rows_c
     if _tree_rows_c is None:
-        tree_rows_rigid.compile(TREE_ROWS_SIGNATURE)
-        _tree_rows_c = tree_rows_rigid.overloads[TREE_ROWS_SIGNATURE.args].entry_point
+        _tree_rows_c = overload_entry(tree_rows_rigid, TREE_ROWS_SIGNATURE)
     return _tree_rows_c
 
 
@@ -1399,8 +1397,7 @@ def _tree_entry() -> Any:
     loaded from the cache) once."""
     global _tree_rigid_c
     if _tree_rigid_c is None:
-        tree_rigid.compile(TREE_SIGNATURE)
-        _tree_rigid_c = tree_rigid.overloads[TREE_SIGNATURE.args].entry_point
+        _tree_rigid_c = overload_entry(tree_rigid, TREE_SIGNATURE)
     return _tree_rigid_c
 
 

@@ -262,9 +262,8 @@ def _evaluate(t, Y, G0, parts, dY, aux, ints, work, iwork):  # type: ignore[no-u
     o += 31
     b = work[o : o + s]
     o += s
-    A = work[o : o + s * (12 if d.solve == TREE else ndof)].reshape(
-        (s, 12 if d.solve == TREE else ndof)
-    )
+    width = 12 if d.solve == TREE else ndof  # the tree's blocks, or the stacked rows
+    A = work[o : o + s * width].reshape((s, width))
     o += s * max(12, ndof)
     out = work[o : o + 4 * ndof + s + 3]
     o += 4 * ndof + s + 3
